@@ -1,0 +1,21 @@
+#pragma once
+// The one exception type of naris: its message is written for a person and says what went
+// wrong, where, and what to do. The command line prints it as `naris: error: <message>`.
+#include <stdexcept>
+#include <string>
+
+#include <fmt/format.h>
+
+namespace naris {
+
+class Error : public std::runtime_error {
+ public:
+  explicit Error(const std::string& message) : std::runtime_error(message) {}
+};
+
+template <class... Args>
+[[noreturn]] void fail(fmt::format_string<Args...> format, Args&&... args) {
+  throw Error(fmt::format(format, std::forward<Args>(args)...));
+}
+
+}  // namespace naris

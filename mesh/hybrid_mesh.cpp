@@ -1,0 +1,98 @@
+#include "hybrid_mesh.h"
+
+#include <algorithm>
+
+namespace naris {
+
+int HybridMesh::patch_id(const std::string& name) const {
+  const auto it = std::find(patch_names.begin(), patch_names.end(), name);
+  return it == patch_names.end() ? -1 : static_cast<int>(it - patch_names.begin());
+}
+
+int HybridMesh::add_patch(const std::string& name) {
+  const int id = patch_id(name);
+  if (id >= 0) return id;
+  patch_names.push_back(name);
+  return static_cast<int>(patch_names.size()) - 1;
+}
+
+double tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                  const Eigen::Vector3d& d) {
+  return (b - a).cross(c - a).dot(d - a) / 6.0;
+}
+
+double pyramid_volume(const HybridMesh& m, const std::array<NodeId, 5>& p) {
+  const auto& x = m.nodes;
+  // Exact for a planar base; for a warped base this is the mean of the two diagonal splits.
+  const double v1 = tet_volume(x[p[0]], x[p[1]], x[p[2]], x[p[4]]) +
+                    tet_volume(x[p[0]], x[p[2]], x[p[3]], x[p[4]]);
+  const double v2 = tet_volume(x[p[0]], x[p[1]], x[p[3]], x[p[4]]) +
+                    tet_volume(x[p[1]], x[p[2]], x[p[3]], x[p[4]]);
+  return 0.5 * (v1 + v2);
+}
+
+double hex_volume(const HybridMesh& m, const std::array<NodeId, 8>& h) {
+  // Divergence theorem over the six (possibly warped) faces, each split from its centroid.
+  static constexpr int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                      {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+  double v = 0.0;
+  for (const auto& f : faces) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int n : f) c += m.nodes[h[n]];
+    c /= 4.0;
+    for (int e = 0; e < 4; ++e) {
+      const auto& a = m.nodes[h[f[e]]];
+      const auto& b = m.nodes[h[f[(e + 1) % 4]]];
+      v += c.dot(a.cross(b)) / 6.0;
+    }
+  }
+  return v;
+}
+
+double mesh_volume(const HybridMesh& m) {
+  double v = 0.0;
+  for (const auto& t : m.tets) v += tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]);
+  for (const auto& p : m.pyramids) v += pyramid_volume(m, p);
+  for (const auto& h : m.hexes) v += hex_volume(m, h);
+  return v;
+}
+
+void flip_orientation(HybridMesh& m) {
+  for (auto& t : m.tets) std::swap(t[1], t[2]);
+  for (auto& p : m.pyramids) std::swap(p[1], p[3]);
+  for (auto& h : m.hexes) {
+    std::swap(h[1], h[3]);
+    std::swap(h[5], h[7]);
+  }
+  for (auto& f : m.boundary_tris) std::swap(f[1], f[2]);
+  for (auto& f : m.boundary_quads) std::swap(f[1], f[3]);
+}
+
+void compact_nodes(HybridMesh& m) {
+  std::vector<NodeId> renumber(m.nodes.size(), -1);
+  auto mark = [&](auto& cells) {
+    for (const auto& c : cells)
+      for (NodeId n : c) renumber[n] = 0;
+  };
+  mark(m.tets);
+  mark(m.pyramids);
+  mark(m.hexes);
+  NodeId next = 0;
+  for (std::size_t i = 0; i < renumber.size(); ++i) {
+    if (renumber[i] < 0) continue;
+    renumber[i] = next;
+    m.nodes[next++] = m.nodes[i];
+  }
+  m.nodes.resize(static_cast<std::size_t>(next));
+  auto apply = [&](auto& cells) {
+    for (auto& c : cells)
+      for (NodeId& n : c) n = renumber[n];
+  };
+  apply(m.tets);
+  apply(m.pyramids);
+  apply(m.hexes);
+  apply(m.boundary_tris);
+  apply(m.boundary_quads);
+}
+
+}  // namespace naris

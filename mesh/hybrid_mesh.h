@@ -1,0 +1,45 @@
+#pragma once
+// The hybrid finite-element mesh: nodes, cells per type in VTK's linear node order with positive
+// orientation, and boundary faces (triangles and quadrilaterals, outward) each with a patch id.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace naris {
+
+using NodeId = std::int32_t;
+
+struct HybridMesh {
+  std::vector<Eigen::Vector3d> nodes;
+  std::vector<std::array<NodeId, 4>> tets;      // VTK_TETRA
+  std::vector<std::array<NodeId, 5>> pyramids;  // VTK_PYRAMID: base 0-1-2-3 (normal to apex), apex 4
+  std::vector<std::array<NodeId, 8>> hexes;     // VTK_HEXAHEDRON
+
+  std::vector<std::array<NodeId, 3>> boundary_tris;
+  std::vector<std::int32_t> boundary_tri_patch;
+  std::vector<std::array<NodeId, 4>> boundary_quads;
+  std::vector<std::int32_t> boundary_quad_patch;
+  std::vector<std::string> patch_names;
+
+  std::size_t cell_count() const { return tets.size() + pyramids.size() + hexes.size(); }
+  int patch_id(const std::string& name) const;  // -1 when absent
+  int add_patch(const std::string& name);       // returns the existing id if present
+};
+
+// Signed volumes; positive for valid cells in VTK order.
+double tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                  const Eigen::Vector3d& d);
+double pyramid_volume(const HybridMesh& m, const std::array<NodeId, 5>& p);
+double hex_volume(const HybridMesh& m, const std::array<NodeId, 8>& h);
+double mesh_volume(const HybridMesh& m);
+
+// Reverses every cell and boundary face: used when the image frame has negative determinant.
+void flip_orientation(HybridMesh& m);
+
+// Drops nodes that no cell uses and renumbers the rest, keeping their order.
+void compact_nodes(HybridMesh& m);
+
+}  // namespace naris

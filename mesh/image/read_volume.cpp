@@ -1,0 +1,221 @@
+#include "image/read_volume.h"
+
+#include <vtkCallbackCommand.h>
+#include <vtkDICOMImageReader.h>
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkImageReader2.h>
+#include <vtkExecutive.h>
+#include <vtkMatrix3x3.h>
+#include <vtkMatrix4x4.h>
+#include <vtkMetaImageReader.h>
+#include <vtkNIFTIImageReader.h>
+#include <vtkNrrdReader.h>
+#include <vtkPointData.h>
+#include <vtkSmartPointer.h>
+#include <vtkXMLImageDataReader.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace naris {
+namespace fs = std::filesystem;
+
+namespace {
+
+// VTK readers report problems through events rather than exceptions: collect them so that the
+// caller gets one clear error instead of messages on the console.
+struct ErrorCollector {
+  std::string message;
+  static void on_error(vtkObject*, unsigned long, void* client, void* call) {
+    auto* self = static_cast<ErrorCollector*>(client);
+    if (self->message.empty() && call) self->message = static_cast<const char*>(call);
+  }
+};
+
+std::string lower_extension(const fs::path& path) {
+  std::string name = path.filename().string();
+  std::transform(name.begin(), name.end(), name.begin(), ::tolower);
+  if (name.ends_with(".nii.gz")) return ".nii.gz";
+  return fs::path(name).extension().string();
+}
+
+std::string first_line(const std::string& s) {
+  std::string line = s.substr(0, s.find('\n'));
+  while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.pop_back();
+  return line;
+}
+
+// vtkNrrdReader keeps only the lengths of `space directions`; the rotation and `space origin`
+// are read here from the header (plain text up to the first blank line).
+void read_nrrd_frame(const fs::path& path, ImageFrame& frame) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  const std::regex vec(R"(\(\s*([^,\s]+)\s*,\s*([^,\s]+)\s*,\s*([^,\s\)]+)\s*\))");
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) break;
+    auto parse_vectors = [&](const std::string& text) {
+      std::vector<Eigen::Vector3d> out;
+      for (std::sregex_iterator it(text.begin(), text.end(), vec), end; it != end; ++it)
+        out.emplace_back(std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3]));
+      return out;
+    };
+    if (line.rfind("space directions:", 0) == 0) {
+      const auto dirs = parse_vectors(line.substr(17));
+      if (dirs.size() != 3) fail("{}: 'space directions' must list three vectors", path.string());
+      for (int a = 0; a < 3; ++a) {
+        const double len = dirs[a].norm();
+        if (!(len > 0.0) || !std::isfinite(len))
+          fail("{}: 'space directions' has a zero or non-finite vector", path.string());
+        frame.spacing[a] = len;
+        frame.direction.col(a) = dirs[a] / len;
+      }
+    } else if (line.rfind("space origin:", 0) == 0) {
+      const auto o = parse_vectors(line.substr(13));
+      if (o.size() == 1) frame.origin = o[0];
+    }
+  }
+}
+
+
+}  // namespace
+
+Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) fail("{}: no such file or folder", path.string());
+
+  ErrorCollector errors;
+  auto cb = vtkSmartPointer<vtkCallbackCommand>::New();
+  cb->SetCallback(&ErrorCollector::on_error);
+  cb->SetClientData(&errors);
+  vtkObject::GlobalWarningDisplayOff();
+
+  VolumeInfo meta;
+  vtkSmartPointer<vtkImageData> image;
+  const std::string ext = fs::is_directory(path) ? std::string("<dir>") : lower_extension(path);
+  ImageFrame frame;
+  bool frame_from_header = false;
+
+  auto run = [&](auto reader) {
+    reader->AddObserver(vtkCommand::ErrorEvent, cb);
+    reader->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, cb);
+    reader->Update();
+    image = reader->GetOutput();
+  };
+
+  if (ext == ".nrrd" || ext == ".nhdr") {
+    meta.format = "nrrd";
+    auto reader = vtkSmartPointer<vtkNrrdReader>::New();
+    reader->SetFileName(path.c_str());
+    if (!reader->CanReadFile(path.c_str()))
+      fail("{}: not a readable NRRD file (bad magic or header)", path.string());
+    run(reader);
+    read_nrrd_frame(path, frame);
+    frame_from_header = true;
+  } else if (ext == ".nii" || ext == ".nii.gz") {
+    meta.format = "nifti";
+    auto reader = vtkSmartPointer<vtkNIFTIImageReader>::New();
+    reader->SetFileName(path.c_str());
+    run(reader);
+    if (errors.message.empty() && image) {
+      vtkMatrix4x4* m = reader->GetSFormMatrix() ? reader->GetSFormMatrix()
+                                                 : reader->GetQFormMatrix();
+      if (m) {
+        for (int r = 0; r < 3; ++r) {
+          for (int c = 0; c < 3; ++c) frame.direction(r, c) = m->GetElement(r, c);
+          frame.origin[r] = m->GetElement(r, 3);
+        }
+        frame_from_header = true;
+        const double* sp = image->GetSpacing();
+        frame.spacing = Eigen::Vector3d(sp[0], sp[1], sp[2]);
+        const double* o = image->GetOrigin();
+        frame.origin += frame.direction * Eigen::Vector3d(o[0], o[1], o[2]);
+      }
+    }
+  } else if (ext == ".mha" || ext == ".mhd") {
+    meta.format = "metaimage";
+    auto reader = vtkSmartPointer<vtkMetaImageReader>::New();
+    reader->SetFileName(path.c_str());
+    if (!reader->CanReadFile(path.c_str()))
+      fail("{}: not a readable MetaImage file", path.string());
+    run(reader);
+  } else if (ext == ".vti") {
+    meta.format = "vti";
+    auto reader = vtkSmartPointer<vtkXMLImageDataReader>::New();
+    reader->SetFileName(path.c_str());
+    run(reader);
+  } else if (ext == "<dir>") {
+    meta.format = "dicom";
+    auto reader = vtkSmartPointer<vtkDICOMImageReader>::New();
+    reader->SetDirectoryName(path.c_str());
+    run(reader);
+  } else {
+    fail("{}: unknown image format '{}' (expected .nrrd, .nhdr, .nii, .nii.gz, .mha, .mhd, "
+         ".vti or a DICOM folder)",
+         path.string(), ext);
+  }
+
+  if (!errors.message.empty())
+    fail("{}: cannot read {} data: {}", path.string(), meta.format, first_line(errors.message));
+  if (!image || !image->GetPointData() || !image->GetPointData()->GetScalars())
+    fail("{}: the file holds no image data (missing, truncated or corrupt)", path.string());
+
+  vtkDataArray* scalars = image->GetPointData()->GetScalars();
+  meta.pixel_type = scalars->GetDataTypeAsString();
+  if (scalars->GetNumberOfComponents() != 1)
+    fail("{}: unsupported pixel type: {} components per voxel (need a scalar image)",
+         path.string(), scalars->GetNumberOfComponents());
+
+  int dims[3];
+  image->GetDimensions(dims);
+  if (dims[0] < 2 || dims[1] < 2 || dims[2] < 2)
+    fail("{}: the image is {}×{}×{}; a volume needs at least two voxels along each axis "
+         "(a single slice cannot be meshed)",
+         path.string(), dims[0], dims[1], dims[2]);
+
+  Volume<float> volume;
+  if (!frame_from_header) {
+    const double* sp = image->GetSpacing();
+    const double* o = image->GetOrigin();
+    frame.spacing = Eigen::Vector3d(sp[0], sp[1], sp[2]);
+    frame.origin = Eigen::Vector3d(o[0], o[1], o[2]);
+    if (vtkMatrix3x3* d = image->GetDirectionMatrix())
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) frame.direction(r, c) = d->GetElement(r, c);
+  }
+  frame.dims = {dims[0], dims[1], dims[2]};
+  volume.frame = frame;
+
+  const vtkIdType n = scalars->GetNumberOfTuples();
+  if (static_cast<std::size_t>(n) != frame.voxel_count())
+    fail("{}: the data holds {} voxels but the header promises {} (truncated file?)",
+         path.string(), n, frame.voxel_count());
+  volume.values.resize(static_cast<std::size_t>(n));
+  double lo = INFINITY, hi = -INFINITY;
+  std::size_t non_finite = 0;
+  for (vtkIdType t = 0; t < n; ++t) {
+    const double v = scalars->GetTuple1(t);
+    if (!std::isfinite(v)) {
+      ++non_finite;
+      continue;
+    }
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+    volume.values[static_cast<std::size_t>(t)] = static_cast<float>(v);
+  }
+  if (non_finite)
+    fail("{}: {} voxels hold NaN or infinite values; fix or mask them before meshing",
+         path.string(), non_finite);
+  meta.min_value = lo;
+  meta.max_value = hi;
+  if (info) *info = meta;
+  return volume;
+}
+
+}  // namespace naris

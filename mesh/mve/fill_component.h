@@ -1,0 +1,41 @@
+#pragma once
+// Fills one inside component of one cube with cells, given the positions of its local points:
+// the first table candidate whose cells all have positive volume, or else an apex found by a
+// small search (see fill_component.cpp). Shared by the mesher and the table tests.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "mve/case_table.h"
+
+namespace naris::mve {
+
+inline constexpr int kMaxLocalPoints = 96;
+
+struct ComponentFill {
+  // Cells and isosurface triangles in local ids; ids from kPrivatePoint0 on are new points whose
+  // positions are in `privates` (id kPrivatePoint0 + n ↔ privates[n]).
+  std::vector<std::array<std::uint8_t, 5>> tets;  // 4 used
+  std::vector<std::array<std::uint8_t, 5>> pyramids;
+  std::vector<std::array<std::uint8_t, 3>> iso_triangles;
+  std::vector<Eigen::Vector3d> privates;
+  bool used_fallback = false;  // not the table's first candidate
+  bool resolved = true;        // false: nothing valid was found (cells are then unusable)
+  void clear() {
+    tets.clear();
+    pyramids.clear();
+    iso_triangles.clear();
+    privates.clear();
+    used_fallback = false;
+    resolved = true;
+  }
+};
+
+// x holds the positions of local points 0–25 (entries for absent points are ignored); it is
+// used as scratch space beyond that. `cube_min` is the cube's lowest corner.
+void fill_component(const Component& comp, const Eigen::Vector3d& cube_min,
+                    std::array<Eigen::Vector3d, kMaxLocalPoints>& x, ComponentFill& out);
+
+}  // namespace naris::mve

@@ -1,0 +1,356 @@
+#include "mve/mve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "mve/case_table.h"
+#include "mve/fill_component.h"
+
+namespace naris::mve {
+
+VolumeField::VolumeField(const Volume<float>& volume, Mode mode, double level)
+    : volume_(volume), mode_(mode), level_(static_cast<float>(level)) {}
+
+void VolumeField::read_slice(int k, std::span<float> out) const {
+  const auto in = volume_.slice(k);
+  switch (mode_) {
+    case Mode::above:
+      for (std::size_t n = 0; n < in.size(); ++n) out[n] = in[n] - level_;
+      break;
+    case Mode::below:
+      for (std::size_t n = 0; n < in.size(); ++n) out[n] = level_ - in[n];
+      break;
+    case Mode::label:  // isopoints halfway between voxel centres, as for any binary mask
+      for (std::size_t n = 0; n < in.size(); ++n) out[n] = in[n] == level_ ? 1.0f : -1.0f;
+      break;
+  }
+}
+
+namespace {
+
+constexpr NodeId kNone = -1;
+
+class Mesher {
+ public:
+  Mesher(const FieldSource& field, const MveOptions& options, HybridMesh& mesh, MveStats& stats)
+      : field_(field), opt_(options), mesh_(mesh), stats_(stats) {
+    const auto& dims = field.frame().dims;
+    for (int a = 0; a < 3; ++a) {
+      lo_[a] = std::max(0, options.crop.lo[a]);
+      hi_[a] = options.crop.hi[a] < 0 ? dims[a] - 1 : std::min(options.crop.hi[a], dims[a] - 1);
+      if (hi_[a] - lo_[a] < 1)
+        fail("the crop box keeps fewer than two voxels along axis {} ({}..{})", a, lo_[a], hi_[a]);
+    }
+    nx_ = hi_[0] - lo_[0] + 1;
+    ny_ = hi_[1] - lo_[1] + 1;
+    nz_ = hi_[2] - lo_[2] + 1;
+    const std::size_t plane = static_cast<std::size_t>(nx_) * ny_;
+    for (int s = 0; s < 2; ++s) {
+      value_[s].resize(plane);
+      vertex_[s].assign(plane, kNone);
+      xedge_[s].assign(plane, kNone);
+      yedge_[s].assign(plane, kNone);
+      zface_[s].assign(plane, kNone);
+    }
+    zedge_.assign(plane, kNone);
+    xface_.assign(plane, kNone);
+    yface_.assign(plane, kNone);
+    raw_.resize(static_cast<std::size_t>(dims[0]) * dims[1]);
+    wall_ = mesh_.add_patch(opt_.wall_patch);
+    for (int s = 0; s < 6; ++s) side_[s] = -1;
+  }
+
+  void run() {
+    Progress progress("mve", static_cast<std::size_t>(nz_ - 1));
+    load_slice(0, 1);
+    for (int k = 0; k + 1 < nz_; ++k) {
+      // Slice k+1 of the previous layer becomes slice 0 of this one.
+      std::swap(value_[0], value_[1]);
+      std::swap(vertex_[0], vertex_[1]);
+      std::swap(xedge_[0], xedge_[1]);
+      std::swap(yedge_[0], yedge_[1]);
+      std::swap(zface_[0], zface_[1]);
+      std::fill(vertex_[1].begin(), vertex_[1].end(), kNone);
+      std::fill(xedge_[1].begin(), xedge_[1].end(), kNone);
+      std::fill(yedge_[1].begin(), yedge_[1].end(), kNone);
+      std::fill(zface_[1].begin(), zface_[1].end(), kNone);
+      std::fill(zedge_.begin(), zedge_.end(), kNone);
+      std::fill(xface_.begin(), xface_.end(), kNone);
+      std::fill(yface_.begin(), yface_.end(), kNone);
+      k_ = k;
+      load_slice(k + 1, 1);
+      for (int j = 0; j + 1 < ny_; ++j)
+        for (int i = 0; i + 1 < nx_; ++i) mesh_cube(i, j);
+      progress.update(static_cast<std::size_t>(k + 1));
+    }
+  }
+
+ private:
+  void load_slice(int k, int s) {
+    field_.read_slice(lo_[2] + k, raw_);
+    const int nxf = field_.frame().dims[0];
+    for (int j = 0; j < ny_; ++j) {
+      const float* src = raw_.data() + static_cast<std::size_t>(lo_[1] + j) * nxf + lo_[0];
+      std::copy(src, src + nx_, value_[s].begin() + static_cast<std::ptrdiff_t>(j) * nx_);
+    }
+  }
+
+  float value(int i, int j, int dz) const {
+    return value_[dz][static_cast<std::size_t>(i) + static_cast<std::size_t>(nx_) * j];
+  }
+
+  NodeId add_node(const Eigen::Vector3d& x) {
+    mesh_.nodes.push_back(x);
+    return static_cast<NodeId>(mesh_.nodes.size() - 1);
+  }
+
+  NodeId vertex_node(int i, int j, int dz) {
+    NodeId& id = vertex_[dz][static_cast<std::size_t>(i) + static_cast<std::size_t>(nx_) * j];
+    if (id == kNone) id = add_node(Eigen::Vector3d(i, j, k_ + dz));
+    return id;
+  }
+
+  NodeId edge_node(int i, int j, int e) {
+    const int a = kEdge[e][0], b = kEdge[e][1];
+    const int gi = i + kCorner[a][0], gj = j + kCorner[a][1], dz = kCorner[a][2];
+    NodeId* slot;
+    switch (e / 4) {
+      case 0: slot = &xedge_[dz][static_cast<std::size_t>(gi) + static_cast<std::size_t>(nx_) * gj]; break;
+      case 1: slot = &yedge_[dz][static_cast<std::size_t>(gi) + static_cast<std::size_t>(nx_) * gj]; break;
+      default: slot = &zedge_[static_cast<std::size_t>(gi) + static_cast<std::size_t>(nx_) * gj]; break;
+    }
+    if (*slot == kNone) {
+      const double fa = value(gi, gj, dz);
+      const double fb = value(i + kCorner[b][0], j + kCorner[b][1], kCorner[b][2]);
+      double t = fa / (fa - fb);
+      t = std::clamp(t, opt_.isopoint_margin, 1.0 - opt_.isopoint_margin);
+      Eigen::Vector3d x(gi, gj, k_ + dz);
+      x[e / 4] += t;
+      *slot = add_node(x);
+    }
+    return *slot;
+  }
+
+  NodeId face_node(int i, int j, int f, NodeId a, NodeId b) {
+    NodeId* slot;
+    const std::size_t row = static_cast<std::size_t>(nx_) * j;
+    switch (f) {
+      case 0: slot = &xface_[i + row]; break;
+      case 1: slot = &xface_[i + 1 + row]; break;
+      case 2: slot = &yface_[i + row]; break;
+      case 3: slot = &yface_[i + row + static_cast<std::size_t>(nx_)]; break;
+      case 4: slot = &zface_[0][i + row]; break;
+      default: slot = &zface_[1][i + row]; break;
+    }
+    if (*slot == kNone) *slot = add_node(0.5 * (mesh_.nodes[a] + mesh_.nodes[b]));
+    return *slot;
+  }
+
+  int side_patch(int side) {
+    if (side_[side] < 0) side_[side] = mesh_.add_patch(opt_.side_patch[side]);
+    return side_[side];
+  }
+
+  bool on_border(int i, int j, int f) const {
+    switch (f) {
+      case 0: return i == 0;
+      case 1: return i + 2 == nx_;
+      case 2: return j == 0;
+      case 3: return j + 2 == ny_;
+      case 4: return k_ == 0;
+      default: return k_ + 2 == nz_;
+    }
+  }
+
+  void add_border_faces(int i, int j, const CaseEntry& entry, const NodeId* ids) {
+    for (int f = 0; f < 6; ++f) {
+      if (!on_border(i, j, f)) continue;
+      const int patch = side_patch(f);
+      for (const auto& poly : entry.face_polygons[f]) {
+        if (poly.size == 3) {
+          mesh_.boundary_tris.push_back({ids[poly.p[0]], ids[poly.p[1]], ids[poly.p[2]]});
+          mesh_.boundary_tri_patch.push_back(patch);
+        } else {
+          mesh_.boundary_quads.push_back(
+              {ids[poly.p[0]], ids[poly.p[1]], ids[poly.p[2]], ids[poly.p[3]]});
+          mesh_.boundary_quad_patch.push_back(patch);
+        }
+      }
+    }
+  }
+
+  void mesh_cube(int i, int j) {
+    float f[8];
+    unsigned config = 0;
+    for (int v = 0; v < 8; ++v) {
+      f[v] = value(i + kCorner[v][0], j + kCorner[v][1], kCorner[v][2]);
+      config |= static_cast<unsigned>(f[v] > 0.0f) << v;
+    }
+    if (config == 0) return;
+    NodeId ids[kMaxLocalPoints];
+    if (config == 255) {
+      ++stats_.inside_cubes;
+      std::array<NodeId, 8> hex;
+      for (int v = 0; v < 8; ++v)
+        hex[v] = ids[v] = vertex_node(i + kCorner[v][0], j + kCorner[v][1], kCorner[v][2]);
+      mesh_.hexes.push_back(hex);
+      if (i == 0 || j == 0 || k_ == 0 || i + 2 == nx_ || j + 2 == ny_ || k_ + 2 == nz_)
+        add_border_faces(i, j, case_entry(255, 0), ids);
+      return;
+    }
+    ++stats_.boundary_cubes;
+
+    // Ambiguous faces: the bilinear saddle value decides (eq. 3.1–3.4). With the inside diagonal
+    // (a, c) and the outside one (b, d), the saddle is inside iff a·c > b·d; ties separate.
+    const std::uint8_t amb = ambiguous_faces(static_cast<std::uint8_t>(config));
+    std::uint8_t connected = 0;
+    for (int fc = 0; fc < 6; ++fc) {
+      if (!(amb >> fc & 1)) continue;
+      const auto& c = kFace[fc];
+      const bool first_inside = f[c[0]] > 0.0f;
+      const double pin = first_inside ? double(f[c[0]]) * f[c[2]] : double(f[c[1]]) * f[c[3]];
+      const double pout = first_inside ? double(f[c[1]]) * f[c[3]] : double(f[c[0]]) * f[c[2]];
+      if (pin > pout) connected |= static_cast<std::uint8_t>(1u << fc);
+    }
+    const CaseEntry& entry = case_entry(static_cast<std::uint8_t>(config), connected);
+
+    for (int v = 0; v < 8; ++v) {
+      if (!(config >> v & 1)) continue;
+      ids[v] = vertex_node(i + kCorner[v][0], j + kCorner[v][1], kCorner[v][2]);
+      x_[v] = mesh_.nodes[ids[v]];
+    }
+    for (int e = 0; e < 12; ++e) {
+      if (!(entry.edge_mask >> e & 1)) continue;
+      ids[kEdgePoint0 + e] = edge_node(i, j, e);
+      x_[kEdgePoint0 + e] = mesh_.nodes[ids[kEdgePoint0 + e]];
+    }
+    for (int fc = 0; fc < 6; ++fc) {
+      if (!(entry.face_point_mask >> fc & 1)) continue;
+      const auto& fe = entry.face_point_edges[fc];
+      ids[kFacePoint0 + fc] =
+          face_node(i, j, fc, ids[kEdgePoint0 + fe[0]], ids[kEdgePoint0 + fe[1]]);
+      x_[kFacePoint0 + fc] = mesh_.nodes[ids[kFacePoint0 + fc]];
+    }
+
+    const Eigen::Vector3d cube_min(i, j, k_);
+    for (const auto& comp : entry.components) {
+      fill_component(comp, cube_min, x_, fill_);
+      stats_.fallback_cubes += fill_.used_fallback;
+      stats_.unresolved_cubes += !fill_.resolved;
+      for (std::size_t n = 0; n < fill_.privates.size(); ++n)
+        ids[kPrivatePoint0 + n] = add_node(fill_.privates[n]);
+      for (const auto& t : fill_.tets) mesh_.tets.push_back({ids[t[0]], ids[t[1]], ids[t[2]], ids[t[3]]});
+      for (const auto& p : fill_.pyramids)
+        mesh_.pyramids.push_back({ids[p[0]], ids[p[1]], ids[p[2]], ids[p[3]], ids[p[4]]});
+      for (const auto& t : fill_.iso_triangles) {
+        mesh_.boundary_tris.push_back({ids[t[0]], ids[t[1]], ids[t[2]]});
+        mesh_.boundary_tri_patch.push_back(wall_);
+      }
+    }
+    add_border_faces(i, j, entry, ids);
+  }
+
+  const FieldSource& field_;
+  const MveOptions& opt_;
+  HybridMesh& mesh_;
+  MveStats& stats_;
+  std::array<int, 3> lo_{}, hi_{};
+  int nx_ = 0, ny_ = 0, nz_ = 0, k_ = 0;
+  std::vector<float> raw_;
+  std::vector<float> value_[2];
+  std::vector<NodeId> vertex_[2], xedge_[2], yedge_[2], zface_[2];
+  std::vector<NodeId> zedge_, xface_, yface_;
+  int wall_ = 0;
+  int side_[6];
+  std::array<Eigen::Vector3d, kMaxLocalPoints> x_;  // local point positions of the cube
+  ComponentFill fill_;
+};
+
+// Keeps the connected component (through shared nodes) with the most cells.
+void keep_largest_component(HybridMesh& mesh, MveStats& stats) {
+  std::vector<NodeId> parent(mesh.nodes.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](NodeId a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  auto unite_cells = [&](const auto& cells) {
+    for (const auto& c : cells) {
+      const NodeId r = find(c[0]);
+      for (NodeId n : c) parent[find(n)] = r;
+    }
+  };
+  unite_cells(mesh.tets);
+  unite_cells(mesh.pyramids);
+  unite_cells(mesh.hexes);
+  std::vector<std::size_t> cells_of(mesh.nodes.size(), 0);
+  auto count = [&](const auto& cells) {
+    for (const auto& c : cells) ++cells_of[find(c[0])];
+  };
+  count(mesh.tets);
+  count(mesh.pyramids);
+  count(mesh.hexes);
+  std::size_t components = 0;
+  NodeId largest = 0;
+  for (std::size_t n = 0; n < cells_of.size(); ++n) {
+    if (!cells_of[n]) continue;
+    ++components;
+    if (cells_of[n] > cells_of[largest]) largest = static_cast<NodeId>(n);
+  }
+  stats.components = components;
+  if (components <= 1) return;
+  stats.dropped_components = components - 1;
+  auto keep = [&](auto& cells) {
+    const auto before = cells.size();
+    std::erase_if(cells, [&](const auto& c) { return find(c[0]) != largest; });
+    stats.dropped_cells += before - cells.size();
+  };
+  keep(mesh.tets);
+  keep(mesh.pyramids);
+  keep(mesh.hexes);
+  auto keep_faces = [&](auto& faces, auto& patches) {
+    std::size_t out = 0;
+    for (std::size_t n = 0; n < faces.size(); ++n) {
+      if (find(faces[n][0]) != largest) continue;
+      faces[out] = faces[n];
+      patches[out++] = patches[n];
+    }
+    faces.resize(out);
+    patches.resize(out);
+  };
+  keep_faces(mesh.boundary_tris, mesh.boundary_tri_patch);
+  keep_faces(mesh.boundary_quads, mesh.boundary_quad_patch);
+}
+
+}  // namespace
+
+HybridMesh march_volume_elements(const FieldSource& field, const MveOptions& options,
+                                 MveStats* stats_out) {
+  Stopwatch clock;
+  MveStats stats;
+  HybridMesh mesh;
+  Mesher mesher(field, options, mesh, stats);
+  mesher.run();
+  if (mesh.cell_count() == 0)
+    fail("nothing is inside: no voxel passes the threshold or label in the meshed region");
+  if (options.keep_largest_component) keep_largest_component(mesh, stats);
+  compact_nodes(mesh);
+
+  // Index space → physical millimetres. A mirroring frame turns every cell inside out, so the
+  // node order is reversed to keep volumes positive.
+  const ImageFrame& frame = field.frame();
+  const Eigen::Matrix3d m = frame.index_to_physical();
+  Eigen::Vector3d offset(options.crop.lo[0] > 0 ? options.crop.lo[0] : 0,
+                         options.crop.lo[1] > 0 ? options.crop.lo[1] : 0,
+                         options.crop.lo[2] > 0 ? options.crop.lo[2] : 0);
+  for (auto& x : mesh.nodes) x = frame.origin + m * (x + offset);
+  if (m.determinant() < 0.0) flip_orientation(mesh);
+  stats.seconds = clock.seconds();
+  if (stats_out) *stats_out = stats;
+  return mesh;
+}
+
+}  // namespace naris::mve

@@ -1,0 +1,74 @@
+#pragma once
+// Marching volume elements (dissertation ch. 3): a conforming hybrid mesh straight from a
+// scalar field on a regular grid — hexahedra for cubes wholly inside, tetrahedra and pyramids
+// in cubes the surface cuts. The volume is streamed slab by slab: besides the output mesh, the
+// mesher holds two slices of the field and the node maps of two slices.
+#include <array>
+#include <cstddef>
+#include <span>
+#include <string>
+
+#include "hybrid_mesh.h"
+#include "image/volume.h"
+
+namespace naris::mve {
+
+// A scalar field sampled on a grid; inside where the value is > 0. Slices are along the third
+// index (k), each nx·ny values with i fastest.
+class FieldSource {
+ public:
+  virtual ~FieldSource() = default;
+  virtual const ImageFrame& frame() const = 0;
+  virtual void read_slice(int k, std::span<float> out) const = 0;
+};
+
+// The box of voxels to mesh (inclusive index bounds). Cube faces on its sides close the object
+// where it touches them; those faces go to the side's patch.
+struct CropBox {
+  std::array<int, 3> lo{0, 0, 0};
+  std::array<int, 3> hi{-1, -1, -1};  // -1: the last voxel
+};
+
+struct MveOptions {
+  CropBox crop;
+  // Patch names of the six sides of the box: −i, +i, −j, +j, −k, +k.
+  std::array<std::string, 6> side_patch{"imin", "imax", "jmin", "jmax", "kmin", "kmax"};
+  std::string wall_patch = "wall";
+  // Isopoints keep at least this fraction of an edge from its vertices so that no cell is flat.
+  double isopoint_margin = 1e-3;
+  bool keep_largest_component = true;
+  bool show_progress = true;
+};
+
+struct MveStats {
+  std::size_t boundary_cubes = 0;
+  std::size_t inside_cubes = 0;
+  std::size_t fallback_cubes = 0;   // a later candidate tessellation had to be used
+  std::size_t unresolved_cubes = 0; // no candidate gave positive volumes (should stay 0)
+  std::size_t components = 0;       // connected mesh components before filtering
+  std::size_t dropped_components = 0;
+  std::size_t dropped_cells = 0;
+  double seconds = 0.0;
+};
+
+// Meshes the inside of the field in physical coordinates (mm). Throws naris::Error when nothing
+// is inside.
+HybridMesh march_volume_elements(const FieldSource& field, const MveOptions& options,
+                                 MveStats* stats = nullptr);
+
+// A FieldSource over a volume in memory: inside where value > threshold (or < threshold when
+// inside_below), or where value == label.
+class VolumeField : public FieldSource {
+ public:
+  enum class Mode { above, below, label };
+  VolumeField(const Volume<float>& volume, Mode mode, double level);
+  const ImageFrame& frame() const override { return volume_.frame; }
+  void read_slice(int k, std::span<float> out) const override;
+
+ private:
+  const Volume<float>& volume_;
+  Mode mode_;
+  float level_;
+};
+
+}  // namespace naris::mve

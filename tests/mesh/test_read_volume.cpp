@@ -1,0 +1,64 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/error.h"
+#include "image/read_volume.h"
+
+namespace naris {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kNeonate = fs::path(NARIS_SHARED_DATA) / "neonate-a.nrrd";
+
+TEST(ReadVolume, ReadsTheNeonateSegmentationWithItsFrame) {
+  if (!fs::exists(kNeonate)) GTEST_SKIP() << "shared data absent: " << kNeonate;
+  VolumeInfo info;
+  const Volume<float> v = read_volume(kNeonate, &info);
+  EXPECT_EQ(v.dims(), (std::array<int, 3>{47, 321, 136}));
+  EXPECT_NEAR(v.frame.spacing[0], 0.75, 0.01);
+  EXPECT_NEAR(v.frame.spacing[1], 0.234, 0.001);
+  EXPECT_NEAR(v.frame.spacing[2], 0.2345, 0.001);
+  EXPECT_NEAR(std::abs(v.frame.direction.determinant()), 1.0, 1e-6);
+  EXPECT_EQ(info.pixel_type, "unsigned char");
+  EXPECT_EQ(info.min_value, 0.0);
+  EXPECT_EQ(info.max_value, 1.0);
+  std::size_t airway = 0;
+  for (float x : v.values) airway += x == 1.0f;
+  // README: one component of 99,390 voxels plus specks; ≈ 4.1 mL of airway.
+  EXPECT_GT(airway, 99390u);
+  const double voxel_ml = v.frame.spacing.prod() / 1000.0;
+  EXPECT_NEAR(static_cast<double>(airway) * voxel_ml, 4.1, 0.2);
+}
+
+TEST(ReadVolume, MissingFileIsAClearError) {
+  try {
+    read_volume("/nonexistent/scan.nrrd");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/scan.nrrd"), std::string::npos);
+  }
+}
+
+TEST(ReadVolume, TruncatedNrrdIsAClearError) {
+  if (!fs::exists(kNeonate)) GTEST_SKIP() << "shared data absent: " << kNeonate;
+  const fs::path cut = fs::temp_directory_path() / "naris-truncated.nrrd";
+  {
+    std::ifstream in(kNeonate, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  }
+  EXPECT_THROW(read_volume(cut), Error);
+  fs::remove(cut);
+}
+
+TEST(ReadVolume, UnknownFormatIsAClearError) {
+  const fs::path junk = fs::temp_directory_path() / "naris-junk.xyz";
+  std::ofstream(junk) << "not an image";
+  EXPECT_THROW(read_volume(junk), Error);
+  fs::remove(junk);
+}
+
+}  // namespace
+}  // namespace naris
