@@ -8,20 +8,22 @@
 
 #include <Eigen/Dense>
 
+#include "core/big_allocator.h"
+
 namespace naris {
 
 using NodeId = std::int32_t;
 
 struct HybridMesh {
-  std::vector<Eigen::Vector3d> nodes;
-  std::vector<std::array<NodeId, 4>> tets;      // VTK_TETRA
-  std::vector<std::array<NodeId, 5>> pyramids;  // VTK_PYRAMID: base 0-1-2-3 (normal to apex), apex 4
-  std::vector<std::array<NodeId, 8>> hexes;     // VTK_HEXAHEDRON
+  BigVector<Eigen::Vector3d> nodes;
+  BigVector<std::array<NodeId, 4>> tets;      // VTK_TETRA
+  BigVector<std::array<NodeId, 5>> pyramids;  // VTK_PYRAMID: base 0-1-2-3 (normal to apex), apex 4
+  BigVector<std::array<NodeId, 8>> hexes;     // VTK_HEXAHEDRON
 
-  std::vector<std::array<NodeId, 3>> boundary_tris;
-  std::vector<std::int32_t> boundary_tri_patch;
-  std::vector<std::array<NodeId, 4>> boundary_quads;
-  std::vector<std::int32_t> boundary_quad_patch;
+  BigVector<std::array<NodeId, 3>> boundary_tris;
+  BigVector<std::int32_t> boundary_tri_patch;
+  BigVector<std::array<NodeId, 4>> boundary_quads;
+  BigVector<std::int32_t> boundary_quad_patch;
   std::vector<std::string> patch_names;
 
   std::size_t cell_count() const { return tets.size() + pyramids.size() + hexes.size(); }

@@ -145,26 +145,24 @@ struct Sampler {
   }
 };
 
-using Points = std::vector<Eigen::Vector3d>;
+using Points = std::array<Eigen::Vector3d, 64>;
 
-Points sample_points(const CaseEntry& entry, const std::array<double, 12>& t) {
-  Points x(kPrivatePoint0, Eigen::Vector3d::Zero());
+void sample_points(const CaseEntry& entry, const std::array<double, 12>& t, Points& x) {
   for (int v = 0; v < 8; ++v) x[v] = Eigen::Vector3d(kCorner[v][0], kCorner[v][1], kCorner[v][2]);
-  for (int e = 0; e < 12; ++e) {
+  for (int e = 0; e < 12; ++e)
     x[kEdgePoint0 + e] = x[kEdge[e][0]] + t[e] * (x[kEdge[e][1]] - x[kEdge[e][0]]);
-  }
   for (int f = 0; f < 6; ++f) {
     const auto& fe = entry.face_point_edges[f];
     if (fe[0] >= 0) x[kFacePoint0 + f] = 0.5 * (x[kEdgePoint0 + fe[0]] + x[kEdgePoint0 + fe[1]]);
   }
-  return x;
 }
 
-double min_cell_volume(const Tessellation& tess, Points x) {
+double min_cell_volume(const Tessellation& tess, Points& x) {
+  int next = kPrivatePoint0;
   for (const auto& pp : tess.privates) {
     Eigen::Vector3d m = Eigen::Vector3d::Zero();
     for (auto s : pp.mean_of) m += x[s];
-    x.push_back(m / static_cast<double>(pp.mean_of.size()));
+    x[next++] = m / static_cast<double>(pp.mean_of.size());
   }
   auto tet = [&](int a, int b, int c, int d) {
     return (x[b] - x[a]).cross(x[c] - x[a]).dot(x[d] - x[a]) / 6.0;
@@ -345,8 +343,11 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
                      centre_of, fan, tess))
         continue;
       int failures = 0;
-      for (const auto& t : sampler.params)
-        if (!(min_cell_volume(tess, sample_points(entry, t)) > 1e-14)) ++failures;
+      Points pts;
+      for (const auto& t : sampler.params) {
+        sample_points(entry, t, pts);
+        if (!(min_cell_volume(tess, pts) > 1e-14)) ++failures;
+      }
       tess.robust = failures == 0;
       ranked.push_back({{failures, static_cast<int>(tess.cells.size())}, std::move(tess)});
     }

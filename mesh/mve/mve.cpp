@@ -84,6 +84,7 @@ class Mesher {
       load_slice(k + 1, 1);
       for (int j = 0; j + 1 < ny_; ++j)
         for (int i = 0; i + 1 < nx_; ++i) mesh_cube(i, j);
+      reserve_ahead(k + 1);
       progress.update(static_cast<std::size_t>(k + 1));
     }
   }
@@ -96,6 +97,22 @@ class Mesher {
       const float* src = raw_.data() + static_cast<std::size_t>(lo_[1] + j) * nxf + lo_[0];
       std::copy(src, src + nx_, value_[s].begin() + static_cast<std::ptrdiff_t>(j) * nx_);
     }
+  }
+
+  // The final sizes are unknown while streaming: extrapolate from the slabs done so far so
+  // that the arrays grow a few times early instead of being copied at every doubling.
+  void reserve_ahead(int layers_done) {
+    const double scale = 1.1 * (nz_ - 1) / layers_done;
+    auto grow = [&](auto& v) {
+      const auto want = static_cast<std::size_t>(scale * static_cast<double>(v.size()));
+      if (v.capacity() < want && want > v.size() + v.size() / 8) v.reserve(want);
+    };
+    grow(mesh_.nodes);
+    grow(mesh_.hexes);
+    grow(mesh_.tets);
+    grow(mesh_.pyramids);
+    grow(mesh_.boundary_tris);
+    grow(mesh_.boundary_tri_patch);
   }
 
   float value(int i, int j, int dz) const {
@@ -286,7 +303,7 @@ void keep_largest_component(HybridMesh& mesh, MveStats& stats) {
   unite_cells(mesh.tets);
   unite_cells(mesh.pyramids);
   unite_cells(mesh.hexes);
-  std::vector<std::size_t> cells_of(mesh.nodes.size(), 0);
+  std::vector<std::uint32_t> cells_of(mesh.nodes.size(), 0);
   auto count = [&](const auto& cells) {
     for (const auto& c : cells) ++cells_of[find(c[0])];
   };
