@@ -68,6 +68,22 @@ void flip_orientation(HybridMesh& m) {
   for (auto& f : m.boundary_quads) std::swap(f[1], f[3]);
 }
 
+void remove_empty_patches(HybridMesh& m) {
+  std::vector<std::size_t> count(m.patch_names.size(), 0);
+  for (auto p : m.boundary_tri_patch) ++count[static_cast<std::size_t>(p)];
+  for (auto p : m.boundary_quad_patch) ++count[static_cast<std::size_t>(p)];
+  std::vector<std::int32_t> renumber(m.patch_names.size(), -1);
+  std::vector<std::string> names;
+  for (std::size_t p = 0; p < count.size(); ++p) {
+    if (!count[p]) continue;
+    renumber[p] = static_cast<std::int32_t>(names.size());
+    names.push_back(m.patch_names[p]);
+  }
+  for (auto& p : m.boundary_tri_patch) p = renumber[static_cast<std::size_t>(p)];
+  for (auto& p : m.boundary_quad_patch) p = renumber[static_cast<std::size_t>(p)];
+  m.patch_names = std::move(names);
+}
+
 void compact_nodes(HybridMesh& m) {
   std::vector<NodeId> renumber(m.nodes.size(), -1);
   auto mark = [&](auto& cells) {

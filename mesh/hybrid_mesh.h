@@ -41,6 +41,9 @@ double mesh_volume(const HybridMesh& m);
 // Reverses every cell and boundary face: used when the image frame has negative determinant.
 void flip_orientation(HybridMesh& m);
 
+// Removes patches without faces and renumbers the rest, keeping their order.
+void remove_empty_patches(HybridMesh& m);
+
 // Drops nodes that no cell uses and renumbers the rest, keeping their order.
 void compact_nodes(HybridMesh& m);
 

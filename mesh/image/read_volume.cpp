@@ -15,6 +15,8 @@
 #include <vtkSmartPointer.h>
 #include <vtkXMLImageDataReader.h>
 
+#include <zlib.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -83,6 +85,58 @@ void read_nrrd_frame(const fs::path& path, ImageFrame& frame) {
   }
 }
 
+
+// vtkNrrdReader does not notice a truncated payload (it hands back what it could read), so the
+// payload length is checked here: the inflated size for gzip, the file size for raw data.
+void check_nrrd_payload(const fs::path& path, std::size_t expected_bytes) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line, encoding = "raw";
+  bool detached = false;
+  std::streamoff data_start = 0;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) {
+      data_start = in.tellg();
+      break;
+    }
+    if (line.rfind("encoding:", 0) == 0) {
+      encoding = line.substr(9);
+      encoding.erase(0, encoding.find_first_not_of(' '));
+    }
+    if (line.rfind("data file:", 0) == 0 || line.rfind("datafile:", 0) == 0) detached = true;
+  }
+  if (detached || data_start <= 0) return;
+  in.clear();
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (encoding == "raw") {
+    if (static_cast<std::size_t>(size - data_start) < expected_bytes)
+      fail("{}: truncated file: {} bytes of voxel data, {} expected", path.string(),
+           size - data_start, expected_bytes);
+    return;
+  }
+  if (encoding != "gzip" && encoding != "gz") return;
+  in.seekg(data_start);
+  std::vector<unsigned char> packed(static_cast<std::size_t>(size - data_start));
+  in.read(reinterpret_cast<char*>(packed.data()), static_cast<std::streamsize>(packed.size()));
+  z_stream z{};
+  if (inflateInit2(&z, 16 + MAX_WBITS) != Z_OK) return;
+  z.next_in = packed.data();
+  z.avail_in = static_cast<uInt>(packed.size());
+  std::vector<unsigned char> chunk(1 << 16);
+  std::size_t total = 0;
+  int rc = Z_OK;
+  while (rc == Z_OK) {
+    z.next_out = chunk.data();
+    z.avail_out = static_cast<uInt>(chunk.size());
+    rc = inflate(&z, Z_NO_FLUSH);
+    total += chunk.size() - z.avail_out;
+  }
+  inflateEnd(&z);
+  if (rc != Z_STREAM_END || total < expected_bytes)
+    fail("{}: truncated or corrupt gzip data: {} of {} bytes could be decompressed",
+         path.string(), total, expected_bytes);
+}
 
 }  // namespace
 
@@ -193,6 +247,9 @@ Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
   volume.frame = frame;
 
   const vtkIdType n = scalars->GetNumberOfTuples();
+  if (meta.format == "nrrd")
+    check_nrrd_payload(path, static_cast<std::size_t>(n) *
+                                 static_cast<std::size_t>(scalars->GetDataTypeSize()));
   if (static_cast<std::size_t>(n) != frame.voxel_count())
     fail("{}: the data holds {} voxels but the header promises {} (truncated file?)",
          path.string(), n, frame.voxel_count());

@@ -355,6 +355,7 @@ HybridMesh march_volume_elements(const FieldSource& field, const MveOptions& opt
     fail("nothing is inside: no voxel passes the threshold or label in the meshed region");
   if (options.keep_largest_component) keep_largest_component(mesh, stats);
   compact_nodes(mesh);
+  remove_empty_patches(mesh);
 
   // Index space → physical millimetres. A mirroring frame turns every cell inside out, so the
   // node order is reversed to keep volumes positive.

@@ -1,0 +1,8 @@
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace naris::app {
+
+void add_mesh_command(CLI::App& app);
+
+}  // namespace naris::app

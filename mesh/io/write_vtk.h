@@ -1,0 +1,21 @@
+#pragma once
+// ParaView files of a hybrid mesh: the volume as .vtu (appended raw binary), the boundary as .vtp
+// with a `patch` cell array, and the boundary surface as binary STL.
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "hybrid_mesh.h"
+
+namespace naris {
+
+// Cell arrays are given in the writer's cell order: tets, then pyramids, then hexes.
+using CellFields = std::map<std::string, std::vector<double>>;
+
+void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
+               const CellFields& cell_fields = {});
+void write_boundary_vtp(const HybridMesh& mesh, const std::filesystem::path& path);
+void write_stl(const HybridMesh& mesh, const std::filesystem::path& path);
+
+}  // namespace naris

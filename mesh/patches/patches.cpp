@@ -1,0 +1,262 @@
+#include "patches/patches.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <regex>
+
+#include "core/error.h"
+
+namespace naris {
+namespace {
+
+std::vector<double> parse_numbers(const std::string& text, const std::string& context) {
+  std::vector<double> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    try {
+      std::size_t used = 0;
+      out.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      fail("'{}': '{}' is not a number", context, item);
+    }
+    if (!std::isfinite(out.back())) fail("'{}': '{}' is not a finite number", context, item);
+    start = end + 1;
+  }
+  return out;
+}
+
+// Clips a field by oblique planes: inside only on each plane's kept side. The plane's scaled
+// distance dominates the field within a hair of the plane, so edges that cross the plane inside
+// the object put their isopoints exactly on it.
+class ClippedField : public mve::FieldSource {
+ public:
+  ClippedField(const mve::FieldSource& base, std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> planes)
+      : base_(base), planes_(std::move(planes)) {
+    scale_ = 1e6 / base.frame().spacing.minCoeff();
+  }
+  const ImageFrame& frame() const override { return base_.frame(); }
+  void read_slice(int k, std::span<float> out) const override {
+    base_.read_slice(k, out);
+    const auto& f = base_.frame();
+    for (int j = 0; j < f.dims[1]; ++j)
+      for (int i = 0; i < f.dims[0]; ++i) {
+        const Eigen::Vector3d x = f.physical(Eigen::Vector3d(i, j, k));
+        float& v = out[static_cast<std::size_t>(j) * f.dims[0] + i];
+        for (const auto& [p, n] : planes_)
+          v = std::min(v, static_cast<float>(scale_ * n.dot(x - p)));
+      }
+  }
+
+ private:
+  const mve::FieldSource& base_;
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> planes_;
+  double scale_;
+};
+
+Eigen::Vector3d inside_centroid(const mve::FieldSource& field) {
+  const auto& d = field.frame().dims;
+  std::vector<float> slice(static_cast<std::size_t>(d[0]) * d[1]);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double count = 0.0;
+  for (int k = 0; k < d[2]; ++k) {
+    field.read_slice(k, slice);
+    for (int j = 0; j < d[1]; ++j)
+      for (int i = 0; i < d[0]; ++i)
+        if (slice[static_cast<std::size_t>(j) * d[0] + i] > 0.0f) {
+          sum += Eigen::Vector3d(i, j, k);
+          count += 1.0;
+        }
+  }
+  if (count == 0.0) fail("nothing is inside: no voxel passes the threshold or label");
+  return sum / count;
+}
+
+}  // namespace
+
+CutPlane parse_cut_plane(const std::string& text) {
+  CutPlane plane;
+  plane.text = text;
+  static const std::regex index_form(R"(^\s*([ijk])\s*=\s*([-+0-9.eE]+)\s*$)");
+  static const std::regex physical_form(R"(^\s*p\s*=\s*([^;]+);\s*n\s*=\s*(.+)$)");
+  std::smatch m;
+  if (std::regex_match(text, m, index_form)) {
+    plane.index_plane = true;
+    plane.axis = m[1].str()[0] - 'i';
+    plane.index = parse_numbers(m[2].str(), text)[0];
+    return plane;
+  }
+  if (std::regex_match(text, m, physical_form)) {
+    const auto p = parse_numbers(m[1].str(), text), n = parse_numbers(m[2].str(), text);
+    if (p.size() != 3 || n.size() != 3)
+      fail("plane '{}': p and n need three numbers each (p=x,y,z;n=nx,ny,nz)", text);
+    plane.point = Eigen::Vector3d(p[0], p[1], p[2]);
+    plane.normal = Eigen::Vector3d(n[0], n[1], n[2]);
+    if (!(plane.normal.norm() > 0.0)) fail("plane '{}': the normal is zero", text);
+    plane.normal.normalize();
+    return plane;
+  }
+  fail("plane '{}' not understood: give a voxel-index plane such as j=20, or a physical one such "
+       "as p=0,12.5,0;n=0,1,0 (millimetres)",
+       text);
+}
+
+bool Region::contains(const Eigen::Vector3d& x) const {
+  if (sphere) return (x - a).norm() <= radius;
+  return (x.array() >= a.array()).all() && (x.array() <= b.array()).all();
+}
+
+Region parse_region(const std::string& text) {
+  static const std::regex form(R"(^\s*([A-Za-z_][A-Za-z0-9_-]*)\s*:\s*(box|sphere)\s*=\s*(.+)$)");
+  std::smatch m;
+  if (!std::regex_match(text, m, form))
+    fail("region '{}' not understood: give name:box=x0,y0,z0,x1,y1,z1 or name:sphere=x,y,z,r "
+         "(millimetres)",
+         text);
+  Region r;
+  r.name = m[1].str();
+  const auto v = parse_numbers(m[3].str(), text);
+  if (m[2].str() == "box") {
+    if (v.size() != 6) fail("region '{}': a box needs six numbers", text);
+    r.a = Eigen::Vector3d(std::min(v[0], v[3]), std::min(v[1], v[4]), std::min(v[2], v[5]));
+    r.b = Eigen::Vector3d(std::max(v[0], v[3]), std::max(v[1], v[4]), std::max(v[2], v[5]));
+  } else {
+    if (v.size() != 4 || !(v[3] > 0.0)) fail("region '{}': a sphere needs x,y,z,r with r > 0", text);
+    r.sphere = true;
+    r.a = Eigen::Vector3d(v[0], v[1], v[2]);
+    r.radius = v[3];
+  }
+  return r;
+}
+
+PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>& cuts,
+                          mve::MveOptions& options) {
+  PreparedCuts prepared;
+  if (cuts.empty()) return prepared;
+  const ImageFrame& frame = field.frame();
+  prepared.centroid_index = inside_centroid(field);
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> clip_planes;
+  for (const Cut& cut : cuts) {
+    int axis = -1;
+    double index = 0.0;
+    if (cut.plane.index_plane) {
+      axis = cut.plane.axis;
+      index = cut.plane.index;
+    } else {
+      // A physical plane along an image axis (within half a degree) is a voxel-index plane.
+      for (int a = 0; a < 3; ++a)
+        if (std::abs(frame.direction.col(a).dot(cut.plane.normal)) > std::cos(0.5 * M_PI / 180.0))
+          axis = a;
+      if (axis >= 0) index = frame.continuous_index(cut.plane.point)[axis];
+    }
+    if (axis >= 0) {
+      const int at = static_cast<int>(std::lround(index));
+      if (at < 0 || at >= frame.dims[axis])
+        fail("{} plane '{}' lies outside the image (index {} of 0..{})", cut.patch,
+             cut.plane.text, at, frame.dims[axis] - 1);
+      if (prepared.centroid_index[axis] >= at) {
+        options.crop.lo[axis] = std::max(options.crop.lo[axis], at);
+        options.side_patch[2 * axis] = cut.patch;
+      } else {
+        options.crop.hi[axis] = options.crop.hi[axis] < 0 ? at : std::min(options.crop.hi[axis], at);
+        options.side_patch[2 * axis + 1] = cut.patch;
+      }
+      continue;
+    }
+    // Oblique: keep the side of the plane that holds the object's centroid.
+    const Eigen::Vector3d c = frame.physical(prepared.centroid_index);
+    Eigen::Vector3d n = cut.plane.normal;
+    if (n.dot(c - cut.plane.point) < 0.0) n = -n;
+    clip_planes.push_back({cut.plane.point, n});
+    Cut oriented = cut;
+    oriented.plane.normal = n;
+    prepared.oblique.push_back(oriented);
+  }
+  if (!clip_planes.empty())
+    prepared.clipped = std::make_unique<ClippedField>(field, std::move(clip_planes));
+  return prepared;
+}
+
+void finish_patches(HybridMesh& mesh, const mve::FieldSource& field, const std::vector<Cut>& cuts,
+                    const PreparedCuts& prepared, const std::vector<Region>& regions,
+                    const std::string& from_patch) {
+  const double tolerance = 1e-6 * field.frame().spacing.minCoeff();
+  for (const Cut& cut : prepared.oblique) {
+    const int id = mesh.add_patch(cut.patch);
+    auto on_plane = [&](const auto& face) {
+      for (NodeId n : face)
+        if (std::abs(cut.plane.normal.dot(mesh.nodes[n] - cut.plane.point)) > tolerance) return false;
+      return true;
+    };
+    for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f)
+      if (on_plane(mesh.boundary_tris[f])) mesh.boundary_tri_patch[f] = id;
+    for (std::size_t f = 0; f < mesh.boundary_quads.size(); ++f)
+      if (on_plane(mesh.boundary_quads[f])) mesh.boundary_quad_patch[f] = id;
+  }
+  const auto report = patch_report(mesh);
+  for (const Cut& cut : cuts) {
+    const auto it = std::find_if(report.begin(), report.end(),
+                                 [&](const PatchReport& r) { return r.name == cut.patch; });
+    if (it == report.end() || it->faces == 0)
+      fail("the {} plane '{}' does not cut the object: no boundary face lies on it (check the "
+           "axis and position; the object spans index {:.0f} on average)",
+           cut.patch, cut.plane.text,
+           cut.plane.index_plane ? prepared.centroid_index[cut.plane.axis] : 0.0);
+  }
+  const int from = mesh.patch_id(from_patch);
+  for (const Region& region : regions) {
+    const int id = mesh.add_patch(region.name);
+    auto centroid = [&](const auto& face) {
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (NodeId n : face) c += mesh.nodes[n];
+      return Eigen::Vector3d(c / static_cast<double>(face.size()));
+    };
+    std::size_t moved = 0;
+    for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f)
+      if (mesh.boundary_tri_patch[f] == from && region.contains(centroid(mesh.boundary_tris[f])))
+        mesh.boundary_tri_patch[f] = id, ++moved;
+    for (std::size_t f = 0; f < mesh.boundary_quads.size(); ++f)
+      if (mesh.boundary_quad_patch[f] == from && region.contains(centroid(mesh.boundary_quads[f])))
+        mesh.boundary_quad_patch[f] = id, ++moved;
+    if (moved == 0)
+      fail("region '{}' contains no {} face: check its coordinates (millimetres, image frame)",
+           region.name, from_patch);
+  }
+}
+
+std::vector<PatchReport> patch_report(const HybridMesh& mesh) {
+  std::vector<PatchReport> report(mesh.patch_names.size());
+  std::vector<std::map<std::pair<NodeId, NodeId>, int>> edges(mesh.patch_names.size());
+  for (std::size_t p = 0; p < report.size(); ++p) report[p].name = mesh.patch_names[p];
+  auto add_face = [&](const auto& face, int patch, double area) {
+    report[patch].faces++;
+    report[patch].area += area;
+    const std::size_t n = face.size();
+    for (std::size_t e = 0; e < n; ++e) {
+      const NodeId a = face[e], b = face[(e + 1) % n];
+      edges[patch][{std::min(a, b), std::max(a, b)}]++;
+    }
+  };
+  for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f) {
+    const auto& t = mesh.boundary_tris[f];
+    const double area =
+        0.5 * (mesh.nodes[t[1]] - mesh.nodes[t[0]]).cross(mesh.nodes[t[2]] - mesh.nodes[t[0]]).norm();
+    add_face(t, mesh.boundary_tri_patch[f], area);
+  }
+  for (std::size_t f = 0; f < mesh.boundary_quads.size(); ++f) {
+    const auto& q = mesh.boundary_quads[f];
+    const double area =
+        0.5 * (mesh.nodes[q[2]] - mesh.nodes[q[0]]).cross(mesh.nodes[q[3]] - mesh.nodes[q[1]]).norm();
+    add_face(q, mesh.boundary_quad_patch[f], area);
+  }
+  // A patch's perimeter: the edges that only one of its own faces uses.
+  for (std::size_t p = 0; p < report.size(); ++p)
+    for (const auto& [e, count] : edges[p])
+      if (count == 1) report[p].perimeter += (mesh.nodes[e.first] - mesh.nodes[e.second]).norm();
+  return report;
+}
+
+}  // namespace naris

@@ -1,0 +1,72 @@
+#pragma once
+// Boundary patches: the inlet and outlet as cut planes, named regions carved out of the wall,
+// and the per-patch report (area; perimeter and hydraulic diameter 4A/P).
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "hybrid_mesh.h"
+#include "mve/mve.h"
+
+namespace naris {
+
+// "i=20", "j=19.5", "k=0" (voxel-index planes) or "p=x,y,z;n=nx,ny,nz" (millimetres).
+struct CutPlane {
+  std::string text;
+  bool index_plane = false;
+  int axis = 0;        // index planes
+  double index = 0.0;  // index planes
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // physical planes
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ(); // physical planes, unit
+};
+CutPlane parse_cut_plane(const std::string& text);
+
+// "name:box=x0,y0,z0,x1,y1,z1" or "name:sphere=x,y,z,r" (millimetres).
+struct Region {
+  std::string name;
+  bool sphere = false;
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+  bool contains(const Eigen::Vector3d& x) const;
+};
+Region parse_region(const std::string& text);
+
+// A named cut: the patch its faces become.
+struct Cut {
+  std::string patch;
+  CutPlane plane;
+};
+
+// Prepares the mesher for the cuts: planes along an image axis become crop-box sides (keeping
+// the side towards the object's centroid); oblique planes clip the field. Returns the field to
+// mesh (the input itself or a clipping wrapper that refers to it).
+struct PreparedCuts {
+  std::unique_ptr<mve::FieldSource> clipped;  // null when every cut is axis-aligned
+  std::vector<Cut> oblique;                   // to be labelled after meshing
+  Eigen::Vector3d centroid_index = Eigen::Vector3d::Zero();
+  const mve::FieldSource& field(const mve::FieldSource& input) const {
+    return clipped ? *clipped : input;
+  }
+};
+PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>& cuts,
+                          mve::MveOptions& options);
+
+// After meshing: labels faces on oblique cut planes, checks that every cut produced a patch,
+// and carves region patches out of `from_patch`.
+void finish_patches(HybridMesh& mesh, const mve::FieldSource& field, const std::vector<Cut>& cuts,
+                    const PreparedCuts& prepared, const std::vector<Region>& regions,
+                    const std::string& from_patch);
+
+struct PatchReport {
+  std::string name;
+  std::size_t faces = 0;
+  double area = 0.0;       // mm²
+  double perimeter = 0.0;  // mm: length of the patch's own boundary edges
+  double hydraulic_diameter() const { return perimeter > 0.0 ? 4.0 * area / perimeter : 0.0; }
+};
+std::vector<PatchReport> patch_report(const HybridMesh& mesh);
+
+}  // namespace naris

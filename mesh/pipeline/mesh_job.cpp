@@ -1,0 +1,262 @@
+#include "pipeline/mesh_job.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "io/atomic_file.h"
+#include "io/mesh_h5.h"
+#include "io/write_gmsh.h"
+#include "io/write_vtk.h"
+
+namespace naris {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Decides what "inside" means and checks that it selects something but not everything.
+mve::VolumeField make_field(const Volume<float>& volume, const MeshJob& job, MeshJobResult& r) {
+  const auto& info = r.input;
+  using Mode = mve::VolumeField::Mode;
+  Mode mode;
+  double level;
+  if (job.threshold && job.label)
+    fail("give either --threshold or --label, not both");
+  if (job.label) {
+    mode = Mode::label;
+    level = *job.label;
+  } else if (job.threshold) {
+    level = *job.threshold;
+    if (!(level > info.min_value && level < info.max_value))
+      fail("{}: threshold {} is outside the data range [{}, {}]: nothing would be separated",
+           job.input.string(), level, info.min_value, info.max_value);
+    mode = job.inside_above ? Mode::above : Mode::below;
+  } else {
+    // A binary labelmap (0/1) needs no option: its airway is label 1.
+    const bool binary = info.min_value >= 0.0 && info.max_value <= 1.0 &&
+                        std::all_of(volume.values.begin(), volume.values.end(),
+                                    [](float v) { return v == 0.0f || v == 1.0f; });
+    if (!binary)
+      fail("{}: the image is not a binary labelmap (values {} .. {}): give --threshold T (CT, "
+           "inside below T) or --label L",
+           job.input.string(), info.min_value, info.max_value);
+    mode = Mode::label;
+    level = 1.0;
+  }
+  std::size_t inside = 0;
+  for (float v : volume.values)
+    inside += mode == Mode::label ? v == level : (mode == Mode::above ? v > level : v < level);
+  if (inside == 0) {
+    if (mode == Mode::label) {
+      std::set<float> present;
+      for (float v : volume.values) {
+        present.insert(v);
+        if (present.size() > 8) break;
+      }
+      fail("{}: empty segmentation: no voxel has label {} (labels present: {})", job.input.string(),
+           level, fmt::join(present, ", "));
+    }
+    fail("{}: no voxel is {} the threshold {}: nothing to mesh", job.input.string(),
+         mode == Mode::above ? "above" : "below", level);
+  }
+  if (inside == volume.values.size())
+    fail("{}: every voxel is inside ({} {}): the object has no boundary in the image; check the "
+         "threshold side (--inside) or crop with --inlet/--outlet",
+         job.input.string(), mode == Mode::label ? "label" : "threshold", level);
+  r.level = level;
+  r.mode = mode == Mode::label ? "label" : (mode == Mode::above ? "above" : "below");
+  return mve::VolumeField(volume, mode, level);
+}
+
+std::string json_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+std::string quality_json(const QualityReport& q) {
+  std::string out = "{";
+  for (std::size_t g = 0; g < q.groups.size(); ++g) {
+    out += fmt::format("{}\"{}\": {{", g ? ", " : "", q.groups[g]);
+    for (std::size_t m = 0; m < kMetrics.size(); ++m) {
+      const auto& s = q.summary[g][m];
+      out += fmt::format(
+          "{}\"{}\": {{\"count\": {}, \"min\": {:.6g}, \"p1\": {:.6g}, \"p5\": {:.6g}, \"p50\": "
+          "{:.6g}, \"p95\": {:.6g}, \"p99\": {:.6g}, \"max\": {:.6g}, \"histogram_range\": [{}, "
+          "{}], \"histogram\": [{}]}}",
+          m ? ", " : "", metric_name(kMetrics[m]), s.count, s.min, s.p1, s.p5, s.p50, s.p95, s.p99,
+          s.max, s.lo, s.hi, fmt::join(s.histogram, ", "));
+    }
+    out += "}";
+  }
+  return out + "}";
+}
+
+}  // namespace
+
+MeshJobResult run_mesh_job(const MeshJob& job) {
+  MeshJobResult r;
+  Stopwatch total;
+  ensure_writable_folder(job.output.parent_path());
+  std::vector<Cut> cuts;
+  if (job.inlet) cuts.push_back({"inlet", parse_cut_plane(*job.inlet)});
+  if (job.outlet) cuts.push_back({"outlet", parse_cut_plane(*job.outlet)});
+  std::vector<Region> regions;
+  for (const auto& text : job.regions) regions.push_back(parse_region(text));
+
+  Stopwatch clock;
+  const Volume<float> volume = read_volume(job.input, &r.input);
+  r.seconds.push_back({"read", clock.seconds()});
+
+  clock = Stopwatch();
+  const mve::VolumeField field = make_field(volume, job, r);
+  mve::MveOptions options;
+  options.keep_largest_component = job.keep_largest;
+  const PreparedCuts prepared = prepare_cuts(field, cuts, options);
+  const mve::FieldSource& source = prepared.field(field);
+  r.mesh = mve::march_volume_elements(source, options, &r.mve);
+  finish_patches(r.mesh, source, cuts, prepared, regions, options.wall_patch);
+  r.seconds.push_back({"mve", clock.seconds()});
+
+  clock = Stopwatch();
+  auto quality = cell_quality(r.mesh);
+  r.before = summarize_quality(r.mesh, quality);
+  if (job.improve) {
+    r.improvement = improve_mesh(r.mesh, volume.frame.spacing.minCoeff(), job.improve_options);
+    quality = cell_quality(r.mesh);
+  }
+  r.after = summarize_quality(r.mesh, quality);
+  r.seconds.push_back({"quality", clock.seconds()});
+  r.patches = patch_report(r.mesh);
+  if (job.check) {
+    clock = Stopwatch();
+    r.check = check_mesh(r.mesh);
+    r.seconds.push_back({"check", clock.seconds()});
+    if (!r.check->valid())
+      fail("internal error: the mesh of {} failed its own checks ({}); please report it with "
+           "the input",
+           job.input.string(), r.check->describe());
+  }
+  r.seconds.push_back({"total", total.seconds()});
+  return r;
+}
+
+void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
+  Stopwatch clock;
+  const fs::path dir = job.output.parent_path();
+  auto sibling = [&](const char* name) { return dir / name; };
+  write_mesh_h5(r.mesh, job.output);
+  r.written.push_back(job.output.string());
+  r.written.push_back(fs::path(job.output).replace_extension(".xdmf").string());
+  if (job.write_vtu) {
+    const auto q = cell_quality(r.mesh);
+    CellFields fields;
+    for (Metric m : kMetrics) {
+      auto& v = fields[metric_name(m)];
+      v.reserve(q.size());
+      for (const auto& c : q) v.push_back(c.get(m));
+    }
+    write_vtu(r.mesh, sibling("mesh.vtu"), fields);
+    write_boundary_vtp(r.mesh, sibling("boundary.vtp"));
+    r.written.push_back(sibling("mesh.vtu").string());
+    r.written.push_back(sibling("boundary.vtp").string());
+  }
+  if (job.write_stl) {
+    write_stl(r.mesh, sibling("surface.stl"));
+    r.written.push_back(sibling("surface.stl").string());
+  }
+  if (job.write_msh) {
+    write_gmsh22(r.mesh, sibling("mesh.msh"));
+    r.written.push_back(sibling("mesh.msh").string());
+  }
+  r.seconds.push_back({"write", clock.seconds()});
+
+  // mesh.json: every number of the summary, for people and for the later stages.
+  std::string patches;
+  for (const auto& p : r.patches)
+    patches += fmt::format(
+        "{}\n    {{\"name\": \"{}\", \"faces\": {}, \"area_mm2\": {:.6g}, \"perimeter_mm\": {:.6g}, "
+        "\"hydraulic_diameter_mm\": {:.6g}}}",
+        patches.empty() ? "" : ",", json_escape(p.name), p.faces, p.area, p.perimeter,
+        p.hydraulic_diameter());
+  std::string seconds;
+  for (const auto& [stage, s] : r.seconds)
+    seconds += fmt::format("{}\"{}\": {:.4f}", seconds.empty() ? "" : ", ", stage, s);
+  const double volume_mm3 = mesh_volume(r.mesh);
+  const std::string json = fmt::format(
+      "{{\n  \"input\": \"{}\",\n  \"mode\": \"{}\",\n  \"level\": {},\n  \"nodes\": {},\n"
+      "  \"cells\": {{\"tet\": {}, \"pyramid\": {}, \"hex\": {}}},\n"
+      "  \"boundary_faces\": {{\"tri\": {}, \"quad\": {}}},\n  \"volume_mm3\": {:.6g},\n"
+      "  \"components\": {},\n  \"dropped_components\": {},\n  \"dropped_cells\": {},\n"
+      "  \"improvement\": {{\"short_edges\": {}, \"collapsed\": {}, \"refused_topology\": {}, "
+      "\"refused_geometry\": {}, \"removed_cells\": {}, \"pyramids_to_tets\": {}}},\n"
+      "  \"patches\": [{}\n  ],\n  \"quality_before\": {},\n  \"quality_after\": {},\n"
+      "  \"seconds\": {{{}}},\n  \"peak_memory_mb\": {:.1f}\n}}\n",
+      json_escape(job.input.string()), r.mode, r.level, r.mesh.nodes.size(), r.mesh.tets.size(),
+      r.mesh.pyramids.size(), r.mesh.hexes.size(), r.mesh.boundary_tris.size(),
+      r.mesh.boundary_quads.size(), volume_mm3, r.mve.components, r.mve.dropped_components,
+      r.mve.dropped_cells, r.improvement.short_edges, r.improvement.collapsed,
+      r.improvement.refused_topology, r.improvement.refused_geometry, r.improvement.removed_cells,
+      r.improvement.pyramids_to_tets, patches, quality_json(r.before), quality_json(r.after),
+      seconds, static_cast<double>(peak_memory_bytes()) / 1e6);
+  AtomicOutput out(sibling("mesh.json"));
+  std::ofstream(out.temp_path()) << json;
+  out.commit();
+  r.written.push_back(sibling("mesh.json").string());
+}
+
+std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
+  const auto& m = r.mesh;
+  std::string s = fmt::format(
+      "naris mesh: {} ({}, {})\n  cells     {} = {} hex + {} pyramid + {} tet\n"
+      "  nodes     {}\n  volume    {:.1f} mm³ ({:.3f} mL)\n",
+      job.input.filename().string(), r.input.format,
+      r.mode == "label" ? fmt::format("label {}", r.level)
+                        : fmt::format("inside {} {}", r.mode, r.level),
+      m.cell_count(), m.hexes.size(), m.pyramids.size(), m.tets.size(), m.nodes.size(),
+      mesh_volume(m), mesh_volume(m) / 1000.0);
+  if (r.mve.dropped_components)
+    s += fmt::format("  dropped   {} small component(s), {} cells (kept the largest)\n",
+                     r.mve.dropped_components, r.mve.dropped_cells);
+  for (const auto& p : r.patches) {
+    s += fmt::format("  patch     {:<10} {:>8} faces {:>12.2f} mm²", p.name, p.faces, p.area);
+    if (p.name == "inlet" || p.name == "outlet")
+      s += fmt::format("  perimeter {:.2f} mm  D_h = 4A/P = {:.3f} mm", p.perimeter,
+                       p.hydraulic_diameter());
+    s += "\n";
+  }
+  auto line = [&](const char* label, const QualityReport& q) {
+    const auto& all = q.summary[3];
+    return fmt::format(
+        "  {:<9} edge ratio p50 {:.2f} p99 {:.2f} max {:.3g} | skew p99 {:.2f} max {:.2f} | "
+        "min dihedral {:.2f}° | scaled Jacobian min {:.3f}\n",
+        label, all[0].p50, all[0].p99, all[0].max, all[1].p99, all[1].max, all[2].min, all[3].min);
+  };
+  s += line("quality", r.before);
+  if (job.improve)
+    s += fmt::format("  improved  {} short edges collapsed ({} refused), {} cells removed, {} "
+                     "pyramids → tets\n",
+                     r.improvement.collapsed,
+                     r.improvement.refused_topology + r.improvement.refused_geometry,
+                     r.improvement.removed_cells, r.improvement.pyramids_to_tets) +
+         line("after", r.after);
+  if (r.check)
+    s += fmt::format("  checked   conforming, watertight, all volumes > 0 (min {:.3g} mm³)\n",
+                     r.check->min_volume);
+  std::string times;
+  for (const auto& [stage, sec] : r.seconds) times += fmt::format(" {} {:.2f}s", stage, sec);
+  s += fmt::format("  time     {}\n  memory    peak {:.0f} MB\n", times,
+                   static_cast<double>(peak_memory_bytes()) / 1e6);
+  if (!r.written.empty()) s += fmt::format("  wrote     {}\n", fmt::join(r.written, "\n            "));
+  return s;
+}
+
+}  // namespace naris

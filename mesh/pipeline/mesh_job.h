@@ -1,0 +1,54 @@
+#pragma once
+// `naris mesh` as a library call: image → field → cuts → MVE → patches → quality improvement →
+// files. Every input problem is detected before the long work starts.
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hybrid_mesh.h"
+#include "image/read_volume.h"
+#include "mve/mve.h"
+#include "patches/patches.h"
+#include "quality/check.h"
+#include "quality/improve.h"
+#include "quality/quality.h"
+
+namespace naris {
+
+struct MeshJob {
+  std::filesystem::path input;
+  std::optional<double> threshold;  // inside is below it by default (air in CT)
+  std::optional<double> label;      // inside is exactly this value
+  bool inside_above = false;        // with a threshold: inside is above it
+  std::optional<std::string> inlet, outlet;
+  std::vector<std::string> regions;  // name:box=... or name:sphere=...
+  bool keep_largest = true;
+  bool improve = true;
+  ImproveOptions improve_options;
+  bool check = true;  // verify conformity and watertightness (costs a sort of all faces)
+  std::filesystem::path output = "mesh.h5";
+  bool write_vtu = true, write_stl = true, write_msh = true;
+};
+
+struct MeshJobResult {
+  HybridMesh mesh;
+  VolumeInfo input;
+  double level = 0.0;  // the threshold or label used
+  std::string mode;    // "label", "below" or "above"
+  mve::MveStats mve;
+  ImproveStats improvement;
+  QualityReport before, after;
+  std::vector<PatchReport> patches;
+  std::optional<MeshCheck> check;
+  std::vector<std::pair<std::string, double>> seconds;  // stage → wall time
+  std::vector<std::string> written;
+};
+
+MeshJobResult run_mesh_job(const MeshJob& job);
+// Writes mesh.h5 (+ .xdmf), mesh.vtu, boundary.vtp, surface.stl, mesh.msh and mesh.json.
+void write_mesh_outputs(const MeshJob& job, MeshJobResult& result);
+std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& result);
+
+}  // namespace naris

@@ -1,0 +1,375 @@
+#include "quality/improve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <unordered_map>
+
+#include "core/log.h"
+
+namespace naris {
+namespace {
+
+using Vec = Eigen::Vector3d;
+
+struct Cell {
+  std::uint8_t size = 0;  // 4, 5, 8; 0 when removed
+  std::array<NodeId, 8> v{};
+};
+
+struct Face {
+  std::uint8_t size = 0;  // 3, 4; 0 when removed
+  std::array<NodeId, 4> v{};
+  std::int32_t patch = 0;
+};
+
+// node → incident items, as a compressed table plus lists gained by merges.
+class Incidence {
+ public:
+  template <class Items>
+  void build(std::size_t nodes, const Items& items) {
+    start_.assign(nodes + 1, 0);
+    for (const auto& it : items)
+      for (int k = 0; k < it.size; ++k) ++start_[static_cast<std::size_t>(it.v[k]) + 1];
+    for (std::size_t n = 0; n < nodes; ++n) start_[n + 1] += start_[n];
+    list_.resize(start_[nodes]);
+    std::vector<std::size_t> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t i = 0; i < items.size(); ++i)
+      for (int k = 0; k < items[i].size; ++k) list_[fill[items[i].v[k]]++] = static_cast<std::int32_t>(i);
+  }
+  template <class F>
+  void for_each(NodeId n, F&& f) const {
+    for (std::size_t i = start_[n]; i < start_[static_cast<std::size_t>(n) + 1]; ++i) f(list_[i]);
+    if (const auto it = extra_.find(n); it != extra_.end())
+      for (auto i : it->second) f(i);
+  }
+  void merge(NodeId from, NodeId into) {
+    auto& dst = extra_[into];
+    for_each(from, [&](std::int32_t i) { dst.push_back(i); });
+  }
+
+ private:
+  std::vector<std::size_t> start_;
+  std::vector<std::int32_t> list_;
+  std::unordered_map<NodeId, std::vector<std::int32_t>> extra_;
+};
+
+bool has(const Cell& c, NodeId n) {
+  return std::find(c.v.begin(), c.v.begin() + c.size, n) != c.v.begin() + c.size;
+}
+bool has(const Face& f, NodeId n) {
+  return std::find(f.v.begin(), f.v.begin() + f.size, n) != f.v.begin() + f.size;
+}
+
+double tet6(const Vec& a, const Vec& b, const Vec& c, const Vec& d) {
+  return (b - a).cross(c - a).dot(d - a);
+}
+
+// Scaled Jacobian of a tet or pyramid (the improved cells), ≤ 0 when inverted.
+double cell_shape(const Cell& c, const std::vector<Vec>& x) {
+  auto corner = [&](int o, int a, int b, int d) {
+    const Vec e1 = x[c.v[a]] - x[c.v[o]], e2 = x[c.v[b]] - x[c.v[o]], e3 = x[c.v[d]] - x[c.v[o]];
+    const double norms = e1.norm() * e2.norm() * e3.norm();
+    return norms > 0.0 ? e1.cross(e2).dot(e3) / norms * std::numbers::sqrt2 : -1.0;
+  };
+  if (c.size == 4)
+    return std::min({corner(0, 1, 2, 3), corner(1, 2, 0, 3), corner(2, 0, 1, 3), corner(3, 0, 2, 1)});
+  // Pyramid: base corners, and every sub-tetrahedron of both base diagonals must be positive.
+  const auto& v = c.v;
+  const double tets = std::min({tet6(x[v[0]], x[v[1]], x[v[2]], x[v[4]]),
+                                tet6(x[v[0]], x[v[2]], x[v[3]], x[v[4]]),
+                                tet6(x[v[0]], x[v[1]], x[v[3]], x[v[4]]),
+                                tet6(x[v[1]], x[v[2]], x[v[3]], x[v[4]])});
+  if (!(tets > 0.0)) return -1.0;
+  return std::min({corner(0, 1, 3, 4), corner(1, 2, 0, 4), corner(2, 3, 1, 4), corner(3, 0, 2, 4)});
+}
+
+Vec face_normal(const Face& f, const std::vector<Vec>& x) {
+  if (f.size == 3) return (x[f.v[1]] - x[f.v[0]]).cross(x[f.v[2]] - x[f.v[0]]);
+  return (x[f.v[2]] - x[f.v[0]]).cross(x[f.v[3]] - x[f.v[1]]);
+}
+
+// The cell after collapsing b into a (a survives); size 0 if it degenerates away.
+Cell collapsed(const Cell& c, NodeId a, NodeId b) {
+  Cell out = c;
+  if (!has(c, b)) return out;
+  if (!has(c, a)) {
+    std::replace(out.v.begin(), out.v.begin() + c.size, b, a);
+    return out;
+  }
+  if (c.size == 4) return Cell{};
+  // Pyramid with base edge (a, b): the base triangle that remains, in base order, and the apex.
+  std::array<NodeId, 3> base;
+  int k = 0;
+  for (int i = 0; i < 4; ++i)
+    if (c.v[i] != b) base[k++] = c.v[i];
+  out.size = 4;
+  out.v = {base[0], base[1], base[2], c.v[4], 0, 0, 0, 0};
+  return out;
+}
+
+Face collapsed(const Face& f, NodeId a, NodeId b) {
+  Face out = f;
+  if (!has(f, b)) return out;
+  if (!has(f, a)) {
+    std::replace(out.v.begin(), out.v.begin() + f.size, b, a);
+    return out;
+  }
+  if (f.size == 3) {
+    out.size = 0;
+    return out;
+  }
+  int k = 0;
+  for (int i = 0; i < 4; ++i)
+    if (f.v[i] != b) out.v[k++] = f.v[i];
+  out.size = 3;
+  return out;
+}
+
+}  // namespace
+
+ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOptions& options) {
+  Stopwatch clock;
+  ImproveStats stats;
+  const double min_edge = options.min_edge_fraction * voxel_size;
+  const std::size_t n_nodes = mesh.nodes.size();
+  std::vector<Vec> x(mesh.nodes.begin(), mesh.nodes.end());
+
+  std::vector<Cell> cells;
+  cells.reserve(mesh.cell_count());
+  for (const auto& t : mesh.tets) cells.push_back({4, {t[0], t[1], t[2], t[3]}});
+  for (const auto& p : mesh.pyramids) cells.push_back({5, {p[0], p[1], p[2], p[3], p[4]}});
+  std::vector<char> locked(n_nodes, 0);
+  for (const auto& h : mesh.hexes) {
+    Cell c{8, {}};
+    std::copy(h.begin(), h.end(), c.v.begin());
+    cells.push_back(c);
+    for (NodeId n : h) locked[n] = 1;
+  }
+  std::vector<Face> faces;
+  faces.reserve(mesh.boundary_tris.size() + mesh.boundary_quads.size());
+  for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f) {
+    const auto& t = mesh.boundary_tris[f];
+    faces.push_back({3, {t[0], t[1], t[2], 0}, mesh.boundary_tri_patch[f]});
+  }
+  for (std::size_t f = 0; f < mesh.boundary_quads.size(); ++f) {
+    const auto& q = mesh.boundary_quads[f];
+    faces.push_back({4, {q[0], q[1], q[2], q[3]}, mesh.boundary_quad_patch[f]});
+  }
+  // A node's patch: -1 interior, ≥ 0 one patch, -2 on a line between patches (never moves).
+  std::vector<std::int32_t> patch(n_nodes, -1);
+  for (const auto& f : faces)
+    for (int k = 0; k < f.size; ++k) {
+      auto& p = patch[f.v[k]];
+      p = p == -1 || p == f.patch ? f.patch : -2;
+    }
+
+  // Candidates: short edges of tetrahedra and pyramids, shortest first.
+  std::vector<std::tuple<double, NodeId, NodeId>> edges;
+  static constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  static constexpr int kPyrEdges[8][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 4}, {1, 4}, {2, 4}, {3, 4}};
+  for (const auto& c : cells) {
+    if (c.size == 8) continue;
+    auto consider = [&](NodeId a, NodeId b) {
+      const double len = (x[a] - x[b]).norm();
+      if (len < min_edge) edges.emplace_back(len, std::min(a, b), std::max(a, b));
+    };
+    if (c.size == 4)
+      for (const auto& e : kTetEdges) consider(c.v[e[0]], c.v[e[1]]);
+    else
+      for (const auto& e : kPyrEdges) consider(c.v[e[0]], c.v[e[1]]);
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  stats.short_edges = edges.size();
+  if (edges.empty()) return stats;
+
+  Incidence node_cells, node_faces;
+  node_cells.build(n_nodes, cells);
+  node_faces.build(n_nodes, faces);
+  std::vector<NodeId> alias(n_nodes);
+  for (std::size_t n = 0; n < n_nodes; ++n) alias[n] = static_cast<NodeId>(n);
+  auto find = [&](NodeId n) {
+    while (alias[n] != n) n = alias[n] = alias[alias[n]];
+    return n;
+  };
+
+  std::vector<std::int32_t> around_a, around_b, faces_ab;
+  std::vector<NodeId> neighbours_a, neighbours_b, allowed;
+  for (const auto& [len0, a0, b0] : edges) {
+    NodeId a = find(a0), b = find(b0);
+    if (a == b || (x[a] - x[b]).norm() >= min_edge) continue;
+    // Which node survives, and where.
+    const bool fixed_a = locked[a] || patch[a] == -2, fixed_b = locked[b] || patch[b] == -2;
+    if (fixed_a && fixed_b) {
+      ++stats.refused_topology;
+      continue;
+    }
+    if (fixed_b || (patch[b] >= 0 && patch[a] == -1)) std::swap(a, b);  // keep the constrained one
+    const bool a_constrained = locked[a] || patch[a] != -1;
+    if (patch[a] >= 0 && patch[b] >= 0 && patch[a] != patch[b]) {
+      ++stats.refused_topology;
+      continue;
+    }
+    if (patch[b] >= 0 && patch[a] == -1) {  // would pull the boundary inside
+      ++stats.refused_topology;
+      continue;
+    }
+    const Vec target = a_constrained && !(patch[a] >= 0 && patch[a] == patch[b] && !locked[a])
+                           ? x[a]
+                           : Vec(0.5 * (x[a] + x[b]));
+
+    around_a.clear();
+    around_b.clear();
+    node_cells.for_each(a, [&](std::int32_t c) {
+      if (cells[c].size && has(cells[c], a)) around_a.push_back(c);
+    });
+    node_cells.for_each(b, [&](std::int32_t c) {
+      if (cells[c].size && has(cells[c], b)) around_b.push_back(c);
+    });
+    std::sort(around_a.begin(), around_a.end());
+    around_a.erase(std::unique(around_a.begin(), around_a.end()), around_a.end());
+    std::sort(around_b.begin(), around_b.end());
+    around_b.erase(std::unique(around_b.begin(), around_b.end()), around_b.end());
+
+    // Topology: the cells on the edge, the pyramid rules, and the link condition.
+    bool ok = true;
+    allowed.clear();
+    for (auto c : around_b) {
+      const Cell& cell = cells[c];
+      if (!has(cell, a)) continue;
+      if (cell.size == 8) ok = false;
+      if (cell.size == 5 && (cell.v[4] == a || cell.v[4] == b)) ok = false;  // lateral edge
+      if (cell.size == 4) {
+        for (int k = 0; k < 4; ++k)
+          if (cell.v[k] != a && cell.v[k] != b) allowed.push_back(cell.v[k]);
+      } else if (cell.size == 5) {
+        allowed.push_back(cell.v[4]);
+      }
+    }
+    auto neighbours = [&](NodeId n, const std::vector<std::int32_t>& around, std::vector<NodeId>& out) {
+      out.clear();
+      for (auto c : around) {
+        const Cell& cell = cells[c];
+        for (int k = 0; k < cell.size; ++k)
+          if (cell.v[k] != n) out.push_back(cell.v[k]);
+      }
+      std::sort(out.begin(), out.end());
+      out.erase(std::unique(out.begin(), out.end()), out.end());
+    };
+    if (ok) {
+      neighbours(a, around_a, neighbours_a);
+      neighbours(b, around_b, neighbours_b);
+      std::sort(allowed.begin(), allowed.end());
+      for (NodeId c : neighbours_a) {
+        if (c == b) continue;
+        if (std::binary_search(neighbours_b.begin(), neighbours_b.end(), c) &&
+            !std::binary_search(allowed.begin(), allowed.end(), c)) {
+          ok = false;
+          break;
+        }
+      }
+    }
+    // Two boundary nodes joined by an interior edge: collapsing would pinch the domain.
+    faces_ab.clear();
+    if (ok && patch[a] != -1 && patch[b] != -1) {
+      bool boundary_edge = false;
+      node_faces.for_each(b, [&](std::int32_t f) {
+        if (faces[f].size && has(faces[f], b) && has(faces[f], a)) boundary_edge = true;
+      });
+      ok = boundary_edge;
+    }
+    if (!ok) {
+      ++stats.refused_topology;
+      continue;
+    }
+
+    // Geometry: every changed cell stays well shaped, no boundary face flips.
+    const Vec xa = x[a], xb = x[b];
+    x[a] = target;
+    x[b] = target;
+    bool shaped = true;
+    for (auto c : around_b) {
+      const Cell after = collapsed(cells[c], a, b);
+      if (after.size && after.size != 8 && cell_shape(after, x) < options.min_scaled_jacobian) shaped = false;
+    }
+    if (shaped && target != xa)
+      for (auto c : around_a) {
+        const Cell& cell = cells[c];
+        if (has(cell, b)) continue;
+        if (cell.size == 8 || cell_shape(cell, x) < options.min_scaled_jacobian) shaped = false;
+      }
+    if (shaped) {
+      auto flips = [&](NodeId n) {
+        bool flipped = false;
+        node_faces.for_each(n, [&](std::int32_t f) {
+          if (!faces[f].size || !has(faces[f], n)) return;
+          const Face after = collapsed(faces[f], a, b);
+          if (!after.size) return;
+          // Normal before (original positions) against normal after.
+          x[a] = xa;
+          x[b] = xb;
+          const Vec before = face_normal(faces[f], x);
+          x[a] = target;
+          x[b] = target;
+          const Vec now = face_normal(after, x);
+          if (!(now.dot(before) > 0.5 * now.norm() * before.norm())) flipped = true;
+        });
+        return flipped;
+      };
+      shaped = !flips(a) && !flips(b);
+    }
+    if (!shaped) {
+      x[a] = xa;
+      x[b] = xb;
+      ++stats.refused_geometry;
+      continue;
+    }
+
+    // Apply.
+    for (auto c : around_b) {
+      const Cell before = cells[c];
+      cells[c] = collapsed(before, a, b);
+      if (!cells[c].size) ++stats.removed_cells;
+      else if (before.size == 5 && cells[c].size == 4) ++stats.pyramids_to_tets;
+    }
+    node_faces.for_each(b, [&](std::int32_t f) {
+      if (faces[f].size && has(faces[f], b)) faces[f] = collapsed(faces[f], a, b);
+    });
+    node_cells.merge(b, a);
+    node_faces.merge(b, a);
+    alias[b] = a;
+    if (locked[b]) locked[a] = 1;
+    ++stats.collapsed;
+  }
+
+  // Back to the mesh arrays.
+  for (std::size_t n = 0; n < n_nodes; ++n) mesh.nodes[n] = x[n];
+  mesh.tets.clear();
+  mesh.pyramids.clear();
+  mesh.hexes.clear();
+  for (const auto& c : cells) {
+    if (c.size == 4) mesh.tets.push_back({c.v[0], c.v[1], c.v[2], c.v[3]});
+    else if (c.size == 5) mesh.pyramids.push_back({c.v[0], c.v[1], c.v[2], c.v[3], c.v[4]});
+    else if (c.size == 8)
+      mesh.hexes.push_back({c.v[0], c.v[1], c.v[2], c.v[3], c.v[4], c.v[5], c.v[6], c.v[7]});
+  }
+  mesh.boundary_tris.clear();
+  mesh.boundary_tri_patch.clear();
+  mesh.boundary_quads.clear();
+  mesh.boundary_quad_patch.clear();
+  for (const auto& f : faces) {
+    if (f.size == 3) {
+      mesh.boundary_tris.push_back({f.v[0], f.v[1], f.v[2]});
+      mesh.boundary_tri_patch.push_back(f.patch);
+    } else if (f.size == 4) {
+      mesh.boundary_quads.push_back({f.v[0], f.v[1], f.v[2], f.v[3]});
+      mesh.boundary_quad_patch.push_back(f.patch);
+    }
+  }
+  compact_nodes(mesh);
+  stats.seconds = clock.seconds();
+  return stats;
+}
+
+}  // namespace naris
