@@ -69,6 +69,7 @@ class Mesher {
     for (int k = 0; k + 1 < nz_; ++k) {
       // Slice k+1 of the previous layer becomes slice 0 of this one.
       std::swap(value_[0], value_[1]);
+      std::swap(object_[0], object_[1]);
       std::swap(vertex_[0], vertex_[1]);
       std::swap(xedge_[0], xedge_[1]);
       std::swap(yedge_[0], yedge_[1]);
@@ -97,6 +98,40 @@ class Mesher {
       const float* src = raw_.data() + static_cast<std::size_t>(lo_[1] + j) * nxf + lo_[0];
       std::copy(src, src + nx_, value_[s].begin() + static_cast<std::ptrdiff_t>(j) * nx_);
     }
+    if (opt_.clip_planes.empty()) return;
+    // Inside means inside the object and on the kept side of every plane: the value is the
+    // minimum; the object's own value is kept for placing isopoints.
+    object_[s] = value_[s];
+    for (int j = 0; j < ny_; ++j)
+      for (int i = 0; i < nx_; ++i) {
+        float& v = value_[s][static_cast<std::size_t>(j) * nx_ + i];
+        const Eigen::Vector3d g(lo_[0] + i, lo_[1] + j, lo_[2] + k);
+        for (const auto& plane : opt_.clip_planes) v = std::min(v, static_cast<float>(plane(g)));
+      }
+  }
+
+  // Edge parameter of the isopoint, measured from vertex a.
+  double crossing(int ia, int ja, int za, int ib, int jb, int zb) const {
+    const double fa = value(ia, ja, za), fb = value(ib, jb, zb);
+    if (opt_.clip_planes.empty()) return fa / (fa - fb);
+    // From the inside end, the first zero of min(object, planes) along the edge.
+    const bool a_inside = fa > 0.0;
+    const int zi = a_inside ? za : zb, zo = a_inside ? zb : za;
+    const int ii = a_inside ? ia : ib, io = a_inside ? ib : ia;
+    const int ji = a_inside ? ja : jb, jo = a_inside ? jb : ja;
+    auto object = [&](int i, int j, int z) {
+      return double(object_[z][static_cast<std::size_t>(i) + static_cast<std::size_t>(nx_) * j]);
+    };
+    double t = 1.0;
+    const double oi = object(ii, ji, zi), oo = object(io, jo, zo);
+    if (oo <= 0.0) t = std::min(t, oi / (oi - oo));
+    const Eigen::Vector3d gi(lo_[0] + ii, lo_[1] + ji, lo_[2] + k_ + zi);
+    const Eigen::Vector3d go(lo_[0] + io, lo_[1] + jo, lo_[2] + k_ + zo);
+    for (const auto& plane : opt_.clip_planes) {
+      const double pi = plane(gi), po = plane(go);
+      if (po <= 0.0) t = std::min(t, pi / (pi - po));
+    }
+    return a_inside ? t : 1.0 - t;
   }
 
   // The final sizes are unknown while streaming: extrapolate from the slabs done so far so
@@ -140,9 +175,7 @@ class Mesher {
       default: slot = &zedge_[static_cast<std::size_t>(gi) + static_cast<std::size_t>(nx_) * gj]; break;
     }
     if (*slot == kNone) {
-      const double fa = value(gi, gj, dz);
-      const double fb = value(i + kCorner[b][0], j + kCorner[b][1], kCorner[b][2]);
-      double t = fa / (fa - fb);
+      double t = crossing(gi, gj, dz, i + kCorner[b][0], j + kCorner[b][1], kCorner[b][2]);
       t = std::clamp(t, opt_.isopoint_margin, 1.0 - opt_.isopoint_margin);
       Eigen::Vector3d x(gi, gj, k_ + dz);
       x[e / 4] += t;
@@ -278,6 +311,7 @@ class Mesher {
   int nx_ = 0, ny_ = 0, nz_ = 0, k_ = 0;
   std::vector<float> raw_;
   std::vector<float> value_[2];
+  std::vector<float> object_[2];  // the object's own values, when clip planes are given
   std::vector<NodeId> vertex_[2], xedge_[2], yedge_[2], zface_[2];
   std::vector<NodeId> zedge_, xface_, yface_;
   int wall_ = 0;

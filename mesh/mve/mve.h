@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "hybrid_mesh.h"
 #include "image/volume.h"
@@ -29,8 +30,18 @@ struct CropBox {
   std::array<int, 3> hi{-1, -1, -1};  // -1: the last voxel
 };
 
+// A half-space kept by the mesher: g(ijk) = normal·ijk + offset > 0, in voxel-index space.
+// Where it cuts the object, isopoints are placed exactly on the plane (the crossing of the
+// minimum of two linear interpolants is the smaller of their crossings).
+struct ClipPlane {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double offset = 0.0;
+  double operator()(const Eigen::Vector3d& ijk) const { return normal.dot(ijk) + offset; }
+};
+
 struct MveOptions {
   CropBox crop;
+  std::vector<ClipPlane> clip_planes;
   // Patch names of the six sides of the box: −i, +i, −j, +j, −k, +k.
   std::array<std::string, 6> side_patch{"imin", "imax", "jmin", "jmax", "kmin", "kmax"};
   std::string wall_patch = "wall";

@@ -29,34 +29,6 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& co
   return out;
 }
 
-// Clips a field by oblique planes: inside only on each plane's kept side. The plane's scaled
-// distance dominates the field within a hair of the plane, so edges that cross the plane inside
-// the object put their isopoints exactly on it.
-class ClippedField : public mve::FieldSource {
- public:
-  ClippedField(const mve::FieldSource& base, std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> planes)
-      : base_(base), planes_(std::move(planes)) {
-    scale_ = 1e6 / base.frame().spacing.minCoeff();
-  }
-  const ImageFrame& frame() const override { return base_.frame(); }
-  void read_slice(int k, std::span<float> out) const override {
-    base_.read_slice(k, out);
-    const auto& f = base_.frame();
-    for (int j = 0; j < f.dims[1]; ++j)
-      for (int i = 0; i < f.dims[0]; ++i) {
-        const Eigen::Vector3d x = f.physical(Eigen::Vector3d(i, j, k));
-        float& v = out[static_cast<std::size_t>(j) * f.dims[0] + i];
-        for (const auto& [p, n] : planes_)
-          v = std::min(v, static_cast<float>(scale_ * n.dot(x - p)));
-      }
-  }
-
- private:
-  const mve::FieldSource& base_;
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> planes_;
-  double scale_;
-};
-
 Eigen::Vector3d inside_centroid(const mve::FieldSource& field) {
   const auto& d = field.frame().dims;
   std::vector<float> slice(static_cast<std::size_t>(d[0]) * d[1]);
@@ -138,7 +110,6 @@ PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>&
   if (cuts.empty()) return prepared;
   const ImageFrame& frame = field.frame();
   prepared.centroid_index = inside_centroid(field);
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> clip_planes;
   for (const Cut& cut : cuts) {
     int axis = -1;
     double index = 0.0;
@@ -170,13 +141,16 @@ PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>&
     const Eigen::Vector3d c = frame.physical(prepared.centroid_index);
     Eigen::Vector3d n = cut.plane.normal;
     if (n.dot(c - cut.plane.point) < 0.0) n = -n;
-    clip_planes.push_back({cut.plane.point, n});
+    // n·(x − p) with x = origin + M·ijk, as a linear function of the voxel index.
+    const Eigen::Matrix3d m = frame.index_to_physical();
+    mve::ClipPlane clip;
+    clip.normal = m.transpose() * n;
+    clip.offset = n.dot(frame.origin - cut.plane.point);
+    options.clip_planes.push_back(clip);
     Cut oriented = cut;
     oriented.plane.normal = n;
     prepared.oblique.push_back(oriented);
   }
-  if (!clip_planes.empty())
-    prepared.clipped = std::make_unique<ClippedField>(field, std::move(clip_planes));
   return prepared;
 }
 

@@ -40,16 +40,12 @@ struct Cut {
   CutPlane plane;
 };
 
-// Prepares the mesher for the cuts: planes along an image axis become crop-box sides (keeping
-// the side towards the object's centroid); oblique planes clip the field. Returns the field to
-// mesh (the input itself or a clipping wrapper that refers to it).
+// Prepares the mesher for the cuts: planes along an image axis become crop-box sides, oblique
+// planes become the mesher's clip planes; either way the side towards the object's centroid is
+// kept.
 struct PreparedCuts {
-  std::unique_ptr<mve::FieldSource> clipped;  // null when every cut is axis-aligned
-  std::vector<Cut> oblique;                   // to be labelled after meshing
+  std::vector<Cut> oblique;  // to be labelled after meshing
   Eigen::Vector3d centroid_index = Eigen::Vector3d::Zero();
-  const mve::FieldSource& field(const mve::FieldSource& input) const {
-    return clipped ? *clipped : input;
-  }
 };
 PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>& cuts,
                           mve::MveOptions& options);

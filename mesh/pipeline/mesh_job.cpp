@@ -121,9 +121,8 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
   mve::MveOptions options;
   options.keep_largest_component = job.keep_largest;
   const PreparedCuts prepared = prepare_cuts(field, cuts, options);
-  const mve::FieldSource& source = prepared.field(field);
-  r.mesh = mve::march_volume_elements(source, options, &r.mve);
-  finish_patches(r.mesh, source, cuts, prepared, regions, options.wall_patch);
+  r.mesh = mve::march_volume_elements(field, options, &r.mve);
+  finish_patches(r.mesh, field, cuts, prepared, regions, options.wall_patch);
   r.seconds.push_back({"mve", clock.seconds()});
 
   clock = Stopwatch();

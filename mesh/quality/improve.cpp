@@ -61,6 +61,14 @@ bool has(const Face& f, NodeId n) {
   return std::find(f.v.begin(), f.v.begin() + f.size, n) != f.v.begin() + f.size;
 }
 
+const std::vector<std::vector<int>>& faces_of(const Cell& c) {
+  static const std::vector<std::vector<int>> tet{{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+  static const std::vector<std::vector<int>> pyramid{{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+  static const std::vector<std::vector<int>> hex{{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                                 {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+  return c.size == 4 ? tet : c.size == 5 ? pyramid : hex;
+}
+
 double tet6(const Vec& a, const Vec& b, const Vec& c, const Vec& d) {
   return (b - a).cross(c - a).dot(d - a);
 }
@@ -194,30 +202,53 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     return n;
   };
 
-  std::vector<std::int32_t> around_a, around_b, faces_ab;
+  std::vector<std::int32_t> around_a, around_b;
+  std::vector<std::pair<NodeId, NodeId>> link_a, link_b, allowed_edges;
+  // Edges of the faces around n that do not touch n: the edge part of n's link.
+  auto link_edges = [&](NodeId n, const std::vector<std::int32_t>& around,
+                        std::vector<std::pair<NodeId, NodeId>>& out) {
+    out.clear();
+    for (auto c : around) {
+      const Cell& cell = cells[c];
+      for (const auto& f : faces_of(cell)) {
+        bool touches = false;
+        for (int k : f) touches = touches || cell.v[k] == n;
+        if (!touches) continue;
+        for (std::size_t k = 0; k < f.size(); ++k) {
+          const NodeId p = cell.v[f[k]], q = cell.v[f[(k + 1) % f.size()]];
+          if (p != n && q != n) out.push_back({std::min(p, q), std::max(p, q)});
+        }
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  };
   std::vector<NodeId> neighbours_a, neighbours_b, allowed;
   for (const auto& [len0, a0, b0] : edges) {
     NodeId a = find(a0), b = find(b0);
     if (a == b || (x[a] - x[b]).norm() >= min_edge) continue;
-    // Which node survives, and where.
-    const bool fixed_a = locked[a] || patch[a] == -2, fixed_b = locked[b] || patch[b] == -2;
-    if (fixed_a && fixed_b) {
+    // Which node survives (a), and where. Hexahedron nodes and nodes on a line between
+    // patches never move. A movable node merges into a fixed one at the fixed position; two
+    // movable nodes meet at their midpoint. A wall node may merge into a fixed interior node,
+    // which then joins the wall (the wall moves by less than the edge, < min_edge).
+    auto movable = [&](NodeId n) { return !locked[n] && patch[n] != -2; };
+    if (!movable(a) && !movable(b)) {
       ++stats.refused_topology;
       continue;
     }
-    if (fixed_b || (patch[b] >= 0 && patch[a] == -1)) std::swap(a, b);  // keep the constrained one
-    const bool a_constrained = locked[a] || patch[a] != -1;
+    if (movable(a) && !movable(b)) std::swap(a, b);
+    else if (movable(a) && movable(b) && patch[a] == -1 && patch[b] >= 0) std::swap(a, b);
+    // Now b moves; a stays unless both are movable with the same patch.
     if (patch[a] >= 0 && patch[b] >= 0 && patch[a] != patch[b]) {
       ++stats.refused_topology;
       continue;
     }
-    if (patch[b] >= 0 && patch[a] == -1) {  // would pull the boundary inside
-      ++stats.refused_topology;
+    if (patch[a] == -2 && patch[b] == -1) {
+      ++stats.refused_topology;  // an interior node onto a patch line: keep it simple
       continue;
     }
-    const Vec target = a_constrained && !(patch[a] >= 0 && patch[a] == patch[b] && !locked[a])
-                           ? x[a]
-                           : Vec(0.5 * (x[a] + x[b]));
+    const bool midpoint = movable(a) && movable(b) && patch[a] == patch[b];
+    const Vec target = midpoint ? Vec(0.5 * (x[a] + x[b])) : x[a];
 
     around_a.clear();
     around_b.clear();
@@ -257,6 +288,29 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
       std::sort(out.begin(), out.end());
       out.erase(std::unique(out.begin(), out.end()), out.end());
     };
+    // Edge part of the link condition: an edge in both links must lie in a cell on edge ab.
+    if (ok) {
+      link_edges(a, around_a, link_a);
+      link_edges(b, around_b, link_b);
+      allowed_edges.clear();
+      for (auto c : around_b) {
+        const Cell& cell = cells[c];
+        if (!has(cell, a)) continue;
+        for (const auto& f : faces_of(cell))
+          for (std::size_t k = 0; k < f.size(); ++k) {
+            const NodeId p = cell.v[f[k]], q = cell.v[f[(k + 1) % f.size()]];
+            if (p != a && p != b && q != a && q != b)
+              allowed_edges.push_back({std::min(p, q), std::max(p, q)});
+          }
+      }
+      std::sort(allowed_edges.begin(), allowed_edges.end());
+      for (const auto& e : link_a)
+        if (std::binary_search(link_b.begin(), link_b.end(), e) &&
+            !std::binary_search(allowed_edges.begin(), allowed_edges.end(), e)) {
+          ok = false;
+          break;
+        }
+    }
     if (ok) {
       neighbours(a, around_a, neighbours_a);
       neighbours(b, around_b, neighbours_b);
@@ -270,14 +324,43 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
         }
       }
     }
-    // Two boundary nodes joined by an interior edge: collapsing would pinch the domain.
-    faces_ab.clear();
+    // Two boundary nodes joined by an interior edge: collapsing would pinch the domain. On the
+    // boundary surface the link condition must hold too: the only boundary nodes adjacent to
+    // both a and b are the third corners of the boundary triangles on edge ab.
     if (ok && patch[a] != -1 && patch[b] != -1) {
       bool boundary_edge = false;
-      node_faces.for_each(b, [&](std::int32_t f) {
-        if (faces[f].size && has(faces[f], b) && has(faces[f], a)) boundary_edge = true;
-      });
+      allowed.clear();
+      auto surface_neighbours = [&](NodeId n, std::vector<NodeId>& out) {
+        out.clear();
+        node_faces.for_each(n, [&](std::int32_t f) {
+          const Face& face = faces[f];
+          if (!face.size || !has(face, n)) return;
+          if (n == b && has(face, a)) {
+            boundary_edge = true;
+            if (face.size == 3)
+              for (int k = 0; k < 3; ++k)
+                if (face.v[k] != a && face.v[k] != b) allowed.push_back(face.v[k]);
+          }
+          for (int k = 0; k < face.size; ++k) {
+            // Neighbours along the face's edges only (not across a quadrilateral's diagonal).
+            const NodeId prev = face.v[(k + face.size - 1) % face.size], next = face.v[(k + 1) % face.size];
+            if (face.v[k] == n) {
+              out.push_back(prev);
+              out.push_back(next);
+            }
+          }
+        });
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+      };
+      surface_neighbours(a, neighbours_a);
+      surface_neighbours(b, neighbours_b);
       ok = boundary_edge;
+      std::sort(allowed.begin(), allowed.end());
+      for (NodeId c : neighbours_a)
+        if (ok && c != b && std::binary_search(neighbours_b.begin(), neighbours_b.end(), c) &&
+            !std::binary_search(allowed.begin(), allowed.end(), c))
+          ok = false;
     }
     if (!ok) {
       ++stats.refused_topology;
@@ -288,16 +371,30 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     const Vec xa = x[a], xb = x[b];
     x[a] = target;
     x[b] = target;
+    // A changed cell must stay valid, and may fall below the quality floor only if it was
+    // already worse before the collapse.
+    auto acceptable = [&](const Cell& before, const Cell& after) {
+      const double now = cell_shape(after, x);
+      if (!(now > 0.0)) return false;
+      if (now >= options.min_scaled_jacobian) return true;
+      x[a] = xa;
+      x[b] = xb;
+      const double old = cell_shape(before, x);
+      x[a] = target;
+      x[b] = target;
+      return now >= old;
+    };
     bool shaped = true;
     for (auto c : around_b) {
       const Cell after = collapsed(cells[c], a, b);
-      if (after.size && after.size != 8 && cell_shape(after, x) < options.min_scaled_jacobian) shaped = false;
+      if (after.size == 8) shaped = false;
+      else if (after.size && !acceptable(cells[c], after)) shaped = false;
     }
     if (shaped && target != xa)
       for (auto c : around_a) {
         const Cell& cell = cells[c];
         if (has(cell, b)) continue;
-        if (cell.size == 8 || cell_shape(cell, x) < options.min_scaled_jacobian) shaped = false;
+        if (cell.size == 8 || !acceptable(cell, cell)) shaped = false;
       }
     if (shaped) {
       auto flips = [&](NodeId n) {
@@ -339,7 +436,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     node_cells.merge(b, a);
     node_faces.merge(b, a);
     alias[b] = a;
-    if (locked[b]) locked[a] = 1;
+    if (patch[a] == -1) patch[a] = patch[b];
     ++stats.collapsed;
   }
 

@@ -1,0 +1,93 @@
+// Quality improvement keeps every invariant and removes the short edges it may remove.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "field_helpers.h"
+#include "quality/check.h"
+#include "quality/improve.h"
+#include "quality/quality.h"
+
+namespace naris {
+namespace {
+
+using testing::ArrayField;
+
+std::size_t short_edges(const HybridMesh& m, double limit) {
+  std::vector<std::pair<NodeId, NodeId>> e;
+  for (const auto& t : m.tets)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b)
+        if ((m.nodes[t[a]] - m.nodes[t[b]]).norm() < limit)
+          e.push_back({std::min(t[a], t[b]), std::max(t[a], t[b])});
+  std::sort(e.begin(), e.end());
+  return static_cast<std::size_t>(std::unique(e.begin(), e.end()) - e.begin());
+}
+
+TEST(Improve, SphereKeepsInvariantsAndVolume) {
+  const int n = 26;
+  ArrayField f(n, n, n);
+  const Eigen::Vector3d c(12.37, 12.71, 12.13);
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        f.at(i, j, k) = static_cast<float>(10.3 - (Eigen::Vector3d(i, j, k) - c).norm());
+  HybridMesh m = mve::march_volume_elements(f, testing::quiet_options());
+  const double v0 = mesh_volume(m);
+  const std::size_t cells0 = m.cell_count();
+  const std::size_t before = short_edges(m, 0.2);
+  const ImproveStats s = improve_mesh(m, 1.0, ImproveOptions{});
+  const MeshCheck c1 = check_mesh(m);
+  ASSERT_TRUE(c1.valid()) << c1.describe();
+  EXPECT_GT(s.collapsed, 0u);
+  EXPECT_LT(m.cell_count(), cells0);
+  // Most short edges go; the rest touch hexahedra or patch lines, or would spoil a cell.
+  std::printf("[ info ] short tet edges %zu → %zu; collapsed %zu, refused %zu + %zu\n", before,
+              short_edges(m, 0.2), s.collapsed, s.refused_topology, s.refused_geometry);
+  EXPECT_LT(short_edges(m, 0.2), before / 2);
+  EXPECT_NEAR(mesh_volume(m), v0, 0.01 * v0);
+  // Hexahedra are untouched.
+  const auto q = cell_quality(m);
+  for (std::size_t i = m.tets.size() + m.pyramids.size(); i < q.size(); ++i)
+    EXPECT_NEAR(q[i].scaled_jacobian, 1.0, 1e-9);
+}
+
+TEST(Improve, RandomFieldsStayConformingWatertightAndPositive) {
+  for (std::uint32_t seed = 1; seed <= 60; ++seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    ArrayField f(12, 11, 10);
+    for (int k = 0; k < 10; ++k)
+      for (int j = 0; j < 11; ++j)
+        for (int i = 0; i < 12; ++i) f.at(i, j, k) = u(rng) + 0.3f;
+    HybridMesh m = mve::march_volume_elements(f, testing::quiet_options());
+    improve_mesh(m, 1.0, ImproveOptions{0.3, 0.02});
+    const MeshCheck c = check_mesh(m);
+    ASSERT_TRUE(c.valid()) << "seed " << seed << ": " << c.describe();
+  }
+}
+
+TEST(Quality, IdealCellsScoreIdeal) {
+  HybridMesh m;
+  const double h = std::sqrt(0.5);
+  m.nodes = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, h},
+             {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  m.pyramids.push_back({0, 1, 2, 3, 4});
+  m.hexes.push_back({0, 1, 2, 3, 5, 6, 7, 8});
+  HybridMesh t;
+  t.nodes = {{0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0},
+             {0.5, std::sqrt(3.0) / 6, std::sqrt(2.0 / 3.0)}};
+  t.tets.push_back({0, 1, 2, 3});
+  for (const HybridMesh* mesh : {&m, &t})
+    for (const auto& q : cell_quality(*mesh)) {
+      EXPECT_NEAR(q.edge_ratio, 1.0, 1e-6);
+      EXPECT_NEAR(q.equiangle_skew, 0.0, 1e-6);
+      EXPECT_NEAR(q.scaled_jacobian, 1.0, 1e-6);
+    }
+  EXPECT_NEAR(cell_quality(t)[0].min_dihedral, std::acos(1.0 / 3.0) * 180 / M_PI, 1e-4);
+  EXPECT_NEAR(cell_quality(m)[1].min_dihedral, 90.0, 1e-4);
+}
+
+}  // namespace
+}  // namespace naris

@@ -1,0 +1,106 @@
+// Output files: the HDF5 round trip, the XDMF sidecar, VTU/VTP/STL read back by VTK, and the
+// Gmsh file's sections and physical groups.
+#include <gtest/gtest.h>
+
+#include <vtkSTLReader.h>
+#include <vtkSmartPointer.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridReader.h>
+#include <vtkPolyData.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "field_helpers.h"
+#include "io/mesh_h5.h"
+#include "io/write_gmsh.h"
+#include "io/write_vtk.h"
+
+namespace naris {
+namespace {
+
+namespace fs = std::filesystem;
+
+HybridMesh sample_mesh() {
+  testing::ArrayField f(9, 8, 7);
+  for (int k = 0; k < 7; ++k)
+    for (int j = 0; j < 8; ++j)
+      for (int i = 0; i < 9; ++i)
+        f.at(i, j, k) = static_cast<float>(3.2 - (Eigen::Vector3d(i, j, k) - Eigen::Vector3d(4.1, 3.7, 3.3)).norm());
+  return mve::march_volume_elements(f, testing::quiet_options());
+}
+
+fs::path temp_dir() {
+  const fs::path d = fs::temp_directory_path() / ("naris-io-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+TEST(MeshH5, RoundTripIsExact) {
+  const HybridMesh m = sample_mesh();
+  ASSERT_FALSE(m.tets.empty());
+  ASSERT_FALSE(m.hexes.empty());
+  const fs::path p = temp_dir() / "mesh.h5";
+  write_mesh_h5(m, p);
+  EXPECT_TRUE(fs::exists(fs::path(p).replace_extension(".xdmf")));
+  const HybridMesh r = read_mesh_h5(p);
+  EXPECT_EQ(r.nodes, m.nodes);
+  EXPECT_EQ(r.tets, m.tets);
+  EXPECT_EQ(r.pyramids, m.pyramids);
+  EXPECT_EQ(r.hexes, m.hexes);
+  EXPECT_EQ(r.boundary_tris, m.boundary_tris);
+  EXPECT_EQ(r.boundary_tri_patch, m.boundary_tri_patch);
+  EXPECT_EQ(r.boundary_quads, m.boundary_quads);
+  EXPECT_EQ(r.patch_names, m.patch_names);
+  for (const auto& e : fs::directory_iterator(p.parent_path()))
+    EXPECT_EQ(e.path().string().find(".part-"), std::string::npos) << "leftover " << e.path();
+}
+
+TEST(MeshH5, RejectsFilesThatAreNotMeshes) {
+  const fs::path p = temp_dir() / "not-a-mesh.h5";
+  std::ofstream(p) << "hello";
+  EXPECT_THROW(read_mesh_h5(p), Error);
+  EXPECT_THROW(read_mesh_h5(temp_dir() / "absent.h5"), Error);
+}
+
+TEST(Vtk, VtuAndStlReadBack) {
+  const HybridMesh m = sample_mesh();
+  const fs::path dir = temp_dir();
+  write_vtu(m, dir / "mesh.vtu");
+  auto reader = vtkSmartPointer<vtkXMLUnstructuredGridReader>::New();
+  reader->SetFileName((dir / "mesh.vtu").c_str());
+  reader->Update();
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), static_cast<vtkIdType>(m.cell_count()));
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfPoints(), static_cast<vtkIdType>(m.nodes.size()));
+  write_stl(m, dir / "surface.stl");
+  auto stl = vtkSmartPointer<vtkSTLReader>::New();
+  stl->SetFileName((dir / "surface.stl").c_str());
+  stl->Update();
+  EXPECT_EQ(stl->GetOutput()->GetNumberOfCells(),
+            static_cast<vtkIdType>(m.boundary_tris.size() + 2 * m.boundary_quads.size()));
+}
+
+TEST(Gmsh, HasPhysicalGroupsAndEveryElement) {
+  HybridMesh m = sample_mesh();
+  const fs::path p = temp_dir() / "mesh.msh";
+  write_gmsh22(m, p);
+  std::ifstream in(p);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "$MeshFormat");
+  std::getline(in, line);
+  EXPECT_EQ(line, "2.2 0 8");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(text.find("\"wall\""), std::string::npos);
+  EXPECT_NE(text.find("3 " + std::to_string(m.patch_names.size() + 1) + " \"fluid\""),
+            std::string::npos);
+  const auto at = text.find("$Elements\n");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t count = std::stoul(text.substr(at + 10));
+  EXPECT_EQ(count, m.cell_count() + m.boundary_tris.size() + m.boundary_quads.size());
+}
+
+}  // namespace
+}  // namespace naris
