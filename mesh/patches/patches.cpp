@@ -174,11 +174,13 @@ void finish_patches(HybridMesh& mesh, const mve::FieldSource& field, const std::
   for (const Cut& cut : cuts) {
     const auto it = std::find_if(report.begin(), report.end(),
                                  [&](const PatchReport& r) { return r.name == cut.patch; });
-    if (it == report.end() || it->faces == 0)
-      fail("the {} plane '{}' does not cut the object: no boundary face lies on it (check the "
-           "axis and position; the object spans index {:.0f} on average)",
-           cut.patch, cut.plane.text,
-           cut.plane.index_plane ? prepared.centroid_index[cut.plane.axis] : 0.0);
+    if (it == report.end() || it->faces == 0) {
+      const Eigen::Vector3d& c = prepared.centroid_index;
+      const Eigen::Vector3d x = field.frame().physical(c);
+      fail("the {} plane '{}' does not cut the object: no boundary face lies on it (the "
+           "object's centroid is at voxel i={:.0f} j={:.0f} k={:.0f}, {:.1f},{:.1f},{:.1f} mm)",
+           cut.patch, cut.plane.text, c[0], c[1], c[2], x[0], x[1], x[2]);
+    }
   }
   const int from = mesh.patch_id(from_patch);
   for (const Region& region : regions) {

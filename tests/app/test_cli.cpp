@@ -1,0 +1,178 @@
+// The command line against bad input: each case must print one line `naris: error: ...` that
+// names the problem, exit non-zero, and leave no output file behind.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status = -1;
+  std::string err;
+};
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("naris-cli-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "in");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  CliRun naris(const std::string& args) {
+    const fs::path err = dir_ / "stderr.txt";
+    const std::string cmd = std::string(NARIS_BINARY) + " " + args + " 2> " + err.string() + " > /dev/null";
+    CliRun r;
+    const int raw = std::system(cmd.c_str());
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    std::ifstream in(err);
+    r.err.assign((std::istreambuf_iterator<char>(in)), {});
+    return r;
+  }
+
+  // A little NRRD with a raw payload; `bytes` may be shorter than the header promises.
+  fs::path nrrd(const std::string& name, const std::string& type, const std::string& sizes,
+                const std::string& bytes, int dimension = 3) {
+    const fs::path p = dir_ / "in" / name;
+    std::ofstream out(p, std::ios::binary);
+    out << "NRRD0004\ntype: " << type << "\ndimension: " << dimension << "\nsizes: " << sizes
+        << "\nencoding: raw\nendian: little\n\n"
+        << bytes;
+    return p;
+  }
+
+  template <class T>
+  static std::string payload(const std::vector<T>& v) {
+    return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+
+  // A 12³ ball of radius 4 as 0/1 labels.
+  static std::vector<std::uint8_t> ball_labels() {
+    std::vector<std::uint8_t> v(12 * 12 * 12);
+    for (int k = 0; k < 12; ++k)
+      for (int j = 0; j < 12; ++j)
+        for (int i = 0; i < 12; ++i)
+          v[static_cast<std::size_t>(i + 12 * (j + 12 * k))] =
+              std::hypot(i - 5.5, j - 5.7, k - 5.6) < 4.0 ? 1 : 0;
+    return v;
+  }
+
+  void expect_clean_failure(const CliRun& r, const std::string& needle) {
+    EXPECT_NE(r.status, 0);
+    EXPECT_EQ(r.err.rfind("naris: error: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << "expected '" << needle << "' in: " << r.err;
+    const fs::path out = dir_ / "out";
+    if (fs::exists(out))
+      for (const auto& e : fs::recursive_directory_iterator(out))
+        ADD_FAILURE() << "left a file behind: " << e.path();
+  }
+
+  std::string out() const { return "-o " + (dir_ / "out" / "mesh.h5").string(); }
+
+  fs::path dir_;
+};
+
+TEST_F(Cli, MeshesABallAndWritesEveryFile) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const CliRun r = naris("mesh " + in.string() + " " + out());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f : {"mesh.h5", "mesh.xdmf", "mesh.vtu", "boundary.vtp", "surface.stl",
+                        "mesh.msh", "mesh.json"})
+    EXPECT_TRUE(fs::exists(dir_ / "out" / f)) << f;
+  EXPECT_NE(r.err.find("conforming, watertight"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, QuietPrintsNothing) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const CliRun r = naris("--quiet mesh " + in.string() + " " + out());
+  ASSERT_EQ(r.status, 0);
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST_F(Cli, MissingFile) {
+  expect_clean_failure(naris("mesh " + (dir_ / "in" / "absent.nrrd").string() + " " + out()),
+                       "absent.nrrd: no such file");
+}
+
+TEST_F(Cli, TruncatedFile) {
+  const std::string bytes = payload(ball_labels());
+  const fs::path in = nrrd("cut.nrrd", "uint8", "12 12 12", bytes.substr(0, bytes.size() / 3));
+  expect_clean_failure(naris("mesh " + in.string() + " " + out()), "cut.nrrd");
+}
+
+TEST_F(Cli, CorruptFile) {
+  const fs::path p = dir_ / "in" / "junk.nrrd";
+  std::ofstream(p) << "this is not an image\x01\x02";
+  expect_clean_failure(naris("mesh " + p.string() + " " + out()), "junk.nrrd");
+}
+
+TEST_F(Cli, UnsupportedPixelType) {
+  std::vector<std::uint8_t> rgb(3 * 12 * 12 * 12, 7);
+  const fs::path in = nrrd("rgb.nrrd", "uint8", "3 12 12 12", payload(rgb), 4);
+  expect_clean_failure(naris("mesh " + in.string() + " " + out()), "rgb.nrrd");
+}
+
+TEST_F(Cli, EmptySegmentation) {
+  const fs::path in = nrrd("empty.nrrd", "uint8", "12 12 12", std::string(12 * 12 * 12, '\0'));
+  expect_clean_failure(naris("mesh " + in.string() + " --label 1 " + out()), "empty segmentation");
+}
+
+TEST_F(Cli, EverythingInside) {
+  const fs::path in = nrrd("full.nrrd", "uint8", "12 12 12", std::string(12 * 12 * 12, '\1'));
+  expect_clean_failure(naris("mesh " + in.string() + " --label 1 " + out()), "every voxel is inside");
+}
+
+TEST_F(Cli, NanValues) {
+  std::vector<float> v(12 * 12 * 12, 1.0f);
+  v[100] = std::numeric_limits<float>::quiet_NaN();
+  const fs::path in = nrrd("nan.nrrd", "float", "12 12 12", payload(v));
+  expect_clean_failure(naris("mesh " + in.string() + " --threshold 0.5 " + out()), "NaN");
+}
+
+TEST_F(Cli, ThresholdOutsideTheDataRange) {
+  std::vector<float> v(12 * 12 * 12);
+  for (std::size_t n = 0; n < v.size(); ++n) v[n] = static_cast<float>(n % 7);
+  const fs::path in = nrrd("ct.nrrd", "float", "12 12 12", payload(v));
+  expect_clean_failure(naris("mesh " + in.string() + " --threshold 500 " + out()),
+                       "outside the data range");
+}
+
+TEST_F(Cli, InletPlaneThatDoesNotCutTheObject) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  expect_clean_failure(naris("mesh " + in.string() + " --inlet k=1 " + out()), "does not cut");
+}
+
+TEST_F(Cli, BadPlaneSyntax) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  expect_clean_failure(naris("mesh " + in.string() + " --inlet q=3 " + out()), "not understood");
+}
+
+TEST_F(Cli, OutputFolderNotWritable) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const CliRun r = naris("mesh " + in.string() + " -o /proc/naris-test/mesh.h5");
+  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(r.err.rfind("naris: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("/proc/naris-test"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, UnknownOptionIsAnError) {
+  const CliRun r = naris("mesh --frobnicate");
+  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(r.err.rfind("naris: error: ", 0), 0u) << r.err;
+}
+
+}  // namespace
