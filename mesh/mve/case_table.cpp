@@ -133,11 +133,11 @@ struct Sampler {
     std::mt19937 rng(20261122);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     const double lo = 1e-3, hi = 1.0 - 1e-3;
-    for (int s = 0; s < 96; ++s) {
+    for (int s = 0; s < 48; ++s) {
       std::array<double, 12> t;
       for (double& x : t) {
-        if (s < 32) x = lo + (hi - lo) * u(rng);
-        else if (s < 64) x = u(rng) < 0.5 ? lo : hi;
+        if (s < 16) x = lo + (hi - lo) * u(rng);
+        else if (s < 32) x = u(rng) < 0.5 ? lo : hi;
         else x = std::array<double, 3>{lo, 0.5, hi}[static_cast<int>(u(rng) * 3) % 3];
       }
       params.push_back(t);

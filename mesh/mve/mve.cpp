@@ -70,6 +70,7 @@ class Mesher {
       // Slice k+1 of the previous layer becomes slice 0 of this one.
       std::swap(value_[0], value_[1]);
       std::swap(object_[0], object_[1]);
+      std::swap(row_inside_[0], row_inside_[1]);
       std::swap(vertex_[0], vertex_[1]);
       std::swap(xedge_[0], xedge_[1]);
       std::swap(yedge_[0], yedge_[1]);
@@ -83,8 +84,13 @@ class Mesher {
       std::fill(yface_.begin(), yface_.end(), kNone);
       k_ = k;
       load_slice(k + 1, 1);
-      for (int j = 0; j + 1 < ny_; ++j)
+      for (int j = 0; j + 1 < ny_; ++j) {
+        // Rows of cubes with no inside vertex make nothing.
+        if (!row_inside_[0][j] && !row_inside_[0][j + 1] && !row_inside_[1][j] &&
+            !row_inside_[1][j + 1])
+          continue;
         for (int i = 0; i + 1 < nx_; ++i) mesh_cube(i, j);
+      }
       reserve_ahead(k + 1);
       progress.update(static_cast<std::size_t>(k + 1));
     }
@@ -98,7 +104,15 @@ class Mesher {
       const float* src = raw_.data() + static_cast<std::size_t>(lo_[1] + j) * nxf + lo_[0];
       std::copy(src, src + nx_, value_[s].begin() + static_cast<std::ptrdiff_t>(j) * nx_);
     }
-    if (opt_.clip_planes.empty()) return;
+    if (!opt_.clip_planes.empty()) apply_clip_planes(k, s);
+    row_inside_[s].assign(static_cast<std::size_t>(ny_), 0);
+    for (int j = 0; j < ny_; ++j) {
+      const float* row = value_[s].data() + static_cast<std::size_t>(j) * nx_;
+      row_inside_[s][j] = std::any_of(row, row + nx_, [](float v) { return v > 0.0f; });
+    }
+  }
+
+  void apply_clip_planes(int k, int s) {
     // Inside means inside the object and on the kept side of every plane: the value is the
     // minimum; the object's own value is kept for placing isopoints.
     object_[s] = value_[s];
@@ -312,6 +326,7 @@ class Mesher {
   std::vector<float> raw_;
   std::vector<float> value_[2];
   std::vector<float> object_[2];  // the object's own values, when clip planes are given
+  std::vector<char> row_inside_[2];
   std::vector<NodeId> vertex_[2], xedge_[2], yedge_[2], zface_[2];
   std::vector<NodeId> zedge_, xface_, yface_;
   int wall_ = 0;
@@ -388,7 +403,8 @@ HybridMesh march_volume_elements(const FieldSource& field, const MveOptions& opt
   if (mesh.cell_count() == 0)
     fail("nothing is inside: no voxel passes the threshold or label in the meshed region");
   if (options.keep_largest_component) keep_largest_component(mesh, stats);
-  compact_nodes(mesh);
+  // Nodes are made only when a cell needs them: unused ones exist only after dropping.
+  if (stats.dropped_components) compact_nodes(mesh);
   remove_empty_patches(mesh);
 
   // Index space → physical millimetres. A mirroring frame turns every cell inside out, so the

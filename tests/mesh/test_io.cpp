@@ -6,6 +6,9 @@
 #include <vtkSmartPointer.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridReader.h>
+#include <vtkCellData.h>
+#include <vtkCellType.h>
+#include <vtkDataArray.h>
 #include <vtkPolyData.h>
 
 #include <filesystem>
@@ -68,12 +71,30 @@ TEST(MeshH5, RejectsFilesThatAreNotMeshes) {
 TEST(Vtk, VtuAndStlReadBack) {
   const HybridMesh m = sample_mesh();
   const fs::path dir = temp_dir();
-  write_vtu(m, dir / "mesh.vtu");
+  CellFields fields;
+  auto& index = fields["index"];
+  for (std::size_t c = 0; c < m.cell_count(); ++c) index.push_back(static_cast<double>(c));
+  write_vtu(m, dir / "mesh.vtu", fields);
   auto reader = vtkSmartPointer<vtkXMLUnstructuredGridReader>::New();
   reader->SetFileName((dir / "mesh.vtu").c_str());
   reader->Update();
-  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), static_cast<vtkIdType>(m.cell_count()));
-  EXPECT_EQ(reader->GetOutput()->GetNumberOfPoints(), static_cast<vtkIdType>(m.nodes.size()));
+  vtkUnstructuredGrid* grid = reader->GetOutput();
+  ASSERT_EQ(grid->GetNumberOfCells(), static_cast<vtkIdType>(m.cell_count()));
+  ASSERT_EQ(grid->GetNumberOfPoints(), static_cast<vtkIdType>(m.nodes.size()));
+  const vtkIdType first_hex = static_cast<vtkIdType>(m.tets.size() + m.pyramids.size());
+  EXPECT_EQ(grid->GetCellType(0), VTK_TETRA);
+  EXPECT_EQ(grid->GetCellType(first_hex), VTK_HEXAHEDRON);
+  vtkIdType n = 0;
+  const vtkIdType* ids = nullptr;
+  grid->GetCellPoints(first_hex, n, ids);
+  ASSERT_EQ(n, 8);
+  for (int k = 0; k < 8; ++k) EXPECT_EQ(ids[k], m.hexes[0][k]);
+  double p[3];
+  grid->GetPoint(5, p);
+  EXPECT_EQ(Eigen::Vector3d(p[0], p[1], p[2]), m.nodes[5]);
+  vtkDataArray* read_index = grid->GetCellData()->GetArray("index");
+  ASSERT_NE(read_index, nullptr);
+  EXPECT_EQ(read_index->GetTuple1(first_hex), static_cast<double>(first_hex));
   write_stl(m, dir / "surface.stl");
   auto stl = vtkSmartPointer<vtkSTLReader>::New();
   stl->SetFileName((dir / "surface.stl").c_str());
