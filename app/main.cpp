@@ -1,7 +1,6 @@
 // The `naris` command line: one subcommand per stage. Errors print as
 // `naris: error: <what, where, what to do>` with a non-zero exit.
 #include <CLI/CLI.hpp>
-
 #include <cstdio>
 #include <exception>
 
@@ -15,9 +14,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   bool quiet = false;
   app.add_flag("-q,--quiet", quiet, "print nothing but errors")->configurable(false);
-  app.parse_complete_callback([&] {
-    naris::set_verbosity(quiet ? naris::Verbosity::quiet : naris::Verbosity::normal);
-  });
+  app.parse_complete_callback(
+      [&] { naris::set_verbosity(quiet ? naris::Verbosity::quiet : naris::Verbosity::normal); });
   naris::app::add_mesh_command(app);
   try {
     app.parse(argc, argv);
@@ -34,7 +32,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "naris: error: %s\n", e.what());
     return 1;
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "naris: error: out of memory (try cropping the image or a coarser grid)\n");
+    std::fprintf(stderr,
+                 "naris: error: out of memory (try cropping the image or a coarser grid)\n");
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "naris: error: %s\n", e.what());

@@ -26,8 +26,9 @@ void add_mesh_command(CLI::App& app) {
       ->required();
   auto* threshold = cmd->add_option("--threshold", options_job->threshold,
                                     "inside is below T (CT air; see --inside)");
-  auto* label = cmd->add_option("--label", options_job->label, "inside is the voxels equal to L "
-                                                       "(default for 0/1 labelmaps: 1)");
+  auto* label = cmd->add_option("--label", options_job->label,
+                                "inside is the voxels equal to L "
+                                "(default for 0/1 labelmaps: 1)");
   threshold->excludes(label);
   cmd->add_option("--inside", opt->inside, "with --threshold: inside is 'below' or 'above' T")
       ->check(CLI::IsMember({"below", "above"}))
@@ -48,7 +49,8 @@ void add_mesh_command(CLI::App& app) {
                 "keep every connected component (default: the largest only)");
   cmd->add_flag("--no-check", opt->no_check, "skip the conformity/watertightness check");
   cmd->add_flag("--no-msh", opt->no_msh, "do not write the Gmsh file");
-  cmd->add_option("-o,--output", options_job->output, "output mesh file (its folder receives the rest)")
+  cmd->add_option("-o,--output", options_job->output,
+                  "output mesh file (its folder receives the rest)")
       ->capture_default_str();
   cmd->callback([opt] {
     MeshJob* const job = &opt->job;  // NOLINT: the same job the options fill
@@ -57,8 +59,7 @@ void add_mesh_command(CLI::App& app) {
     job->keep_largest = !opt->all_components;
     job->check = !opt->no_check;
     job->write_msh = !opt->no_msh;
-    if (job->output.extension() != ".h5")
-      job->output.replace_extension(".h5");
+    if (job->output.extension() != ".h5") job->output.replace_extension(".h5");
     MeshJobResult result = run_mesh_job(*job);
     write_mesh_outputs(*job, result);
     log_line(format_mesh_summary(*job, result));

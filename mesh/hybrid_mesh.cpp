@@ -51,7 +51,8 @@ double hex_volume(const HybridMesh& m, const std::array<NodeId, 8>& h) {
 
 double mesh_volume(const HybridMesh& m) {
   double v = 0.0;
-  for (const auto& t : m.tets) v += tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]);
+  for (const auto& t : m.tets)
+    v += tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]);
   for (const auto& p : m.pyramids) v += pyramid_volume(m, p);
   for (const auto& h : m.hexes) v += hex_volume(m, h);
   return v;

@@ -1,12 +1,11 @@
 #pragma once
 // The hybrid finite-element mesh: nodes, cells per type in VTK's linear node order with positive
 // orientation, and boundary faces (triangles and quadrilaterals, outward) each with a patch id.
+#include <Eigen/Dense>
 #include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <Eigen/Dense>
 
 #include "core/big_allocator.h"
 

@@ -30,11 +30,15 @@ struct BigAllocator {
   }
   void deallocate(T* p, std::size_t n) noexcept {
     const std::size_t bytes = n * sizeof(T);
-    if (bytes < kThreshold) std::allocator<T>().deallocate(p, n);
-    else munmap(p, bytes);
+    if (bytes < kThreshold)
+      std::allocator<T>().deallocate(p, n);
+    else
+      munmap(p, bytes);
   }
   template <class U>
-  bool operator==(const BigAllocator<U>&) const noexcept { return true; }
+  bool operator==(const BigAllocator<U>&) const noexcept {
+    return true;
+  }
 };
 
 template <class T>

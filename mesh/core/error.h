@@ -1,10 +1,10 @@
 #pragma once
 // The one exception type of naris: its message is written for a person and says what went
 // wrong, where, and what to do. The command line prints it as `naris: error: <message>`.
+#include <fmt/format.h>
+
 #include <stdexcept>
 #include <string>
-
-#include <fmt/format.h>
 
 namespace naris {
 

@@ -11,8 +11,12 @@ namespace {
 Verbosity g_verbosity = Verbosity::normal;
 }
 
-void set_verbosity(Verbosity v) { g_verbosity = v; }
-Verbosity verbosity() { return g_verbosity; }
+void set_verbosity(Verbosity v) {
+  g_verbosity = v;
+}
+Verbosity verbosity() {
+  return g_verbosity;
+}
 
 void log_line(const std::string& line) {
   if (g_verbosity == Verbosity::quiet) return;
@@ -39,7 +43,9 @@ Progress::Progress(std::string label, std::size_t total)
       total_(total),
       active_(g_verbosity != Verbosity::quiet && isatty(STDERR_FILENO)) {}
 
-Progress::~Progress() { finish(); }
+Progress::~Progress() {
+  finish();
+}
 
 void Progress::update(std::size_t done) {
   if (!active_) return;

@@ -3,9 +3,9 @@
 #include <vtkCallbackCommand.h>
 #include <vtkDICOMImageReader.h>
 #include <vtkDataArray.h>
+#include <vtkExecutive.h>
 #include <vtkImageData.h>
 #include <vtkImageReader2.h>
-#include <vtkExecutive.h>
 #include <vtkMatrix3x3.h>
 #include <vtkMatrix4x4.h>
 #include <vtkMetaImageReader.h>
@@ -14,7 +14,6 @@
 #include <vtkPointData.h>
 #include <vtkSmartPointer.h>
 #include <vtkXMLImageDataReader.h>
-
 #include <zlib.h>
 
 #include <algorithm>
@@ -85,7 +84,6 @@ void read_nrrd_frame(const fs::path& path, ImageFrame& frame) {
   }
 }
 
-
 // vtkNrrdReader does not notice a truncated payload (it hands back what it could read), so the
 // payload length is checked here: the inflated size for gzip, the file size for raw data.
 void check_nrrd_payload(const fs::path& path, std::size_t expected_bytes) {
@@ -134,8 +132,8 @@ void check_nrrd_payload(const fs::path& path, std::size_t expected_bytes) {
   }
   inflateEnd(&z);
   if (rc != Z_STREAM_END || total < expected_bytes)
-    fail("{}: truncated or corrupt gzip data: {} of {} bytes could be decompressed",
-         path.string(), total, expected_bytes);
+    fail("{}: truncated or corrupt gzip data: {} of {} bytes could be decompressed", path.string(),
+         total, expected_bytes);
 }
 
 }  // namespace
@@ -178,8 +176,8 @@ Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
     reader->SetFileName(path.c_str());
     run(reader);
     if (errors.message.empty() && image) {
-      vtkMatrix4x4* m = reader->GetSFormMatrix() ? reader->GetSFormMatrix()
-                                                 : reader->GetQFormMatrix();
+      vtkMatrix4x4* m =
+          reader->GetSFormMatrix() ? reader->GetSFormMatrix() : reader->GetQFormMatrix();
       if (m) {
         for (int r = 0; r < 3; ++r) {
           for (int c = 0; c < 3; ++c) frame.direction(r, c) = m->GetElement(r, c);
@@ -210,9 +208,10 @@ Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
     reader->SetDirectoryName(path.c_str());
     run(reader);
   } else {
-    fail("{}: unknown image format '{}' (expected .nrrd, .nhdr, .nii, .nii.gz, .mha, .mhd, "
-         ".vti or a DICOM folder)",
-         path.string(), ext);
+    fail(
+        "{}: unknown image format '{}' (expected .nrrd, .nhdr, .nii, .nii.gz, .mha, .mhd, "
+        ".vti or a DICOM folder)",
+        path.string(), ext);
   }
 
   if (!errors.message.empty())
@@ -223,15 +222,16 @@ Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
   vtkDataArray* scalars = image->GetPointData()->GetScalars();
   meta.pixel_type = scalars->GetDataTypeAsString();
   if (scalars->GetNumberOfComponents() != 1)
-    fail("{}: unsupported pixel type: {} components per voxel (need a scalar image)",
-         path.string(), scalars->GetNumberOfComponents());
+    fail("{}: unsupported pixel type: {} components per voxel (need a scalar image)", path.string(),
+         scalars->GetNumberOfComponents());
 
   int dims[3];
   image->GetDimensions(dims);
   if (dims[0] < 2 || dims[1] < 2 || dims[2] < 2)
-    fail("{}: the image is {}×{}×{}; a volume needs at least two voxels along each axis "
-         "(a single slice cannot be meshed)",
-         path.string(), dims[0], dims[1], dims[2]);
+    fail(
+        "{}: the image is {}×{}×{}; a volume needs at least two voxels along each axis "
+        "(a single slice cannot be meshed)",
+        path.string(), dims[0], dims[1], dims[2]);
 
   Volume<float> volume;
   if (!frame_from_header) {
@@ -248,11 +248,11 @@ Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
 
   const vtkIdType n = scalars->GetNumberOfTuples();
   if (meta.format == "nrrd")
-    check_nrrd_payload(path, static_cast<std::size_t>(n) *
-                                 static_cast<std::size_t>(scalars->GetDataTypeSize()));
+    check_nrrd_payload(
+        path, static_cast<std::size_t>(n) * static_cast<std::size_t>(scalars->GetDataTypeSize()));
   if (static_cast<std::size_t>(n) != frame.voxel_count())
-    fail("{}: the data holds {} voxels but the header promises {} (truncated file?)",
-         path.string(), n, frame.voxel_count());
+    fail("{}: the data holds {} voxels but the header promises {} (truncated file?)", path.string(),
+         n, frame.voxel_count());
   volume.values.resize(static_cast<std::size_t>(n));
   double lo = INFINITY, hi = -INFINITY;
   std::size_t non_finite = 0;

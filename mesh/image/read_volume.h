@@ -10,8 +10,8 @@
 namespace naris {
 
 struct VolumeInfo {
-  std::string format;       // "nrrd", "nifti", ...
-  std::string pixel_type;   // the file's scalar type, e.g. "uint8"
+  std::string format;      // "nrrd", "nifti", ...
+  std::string pixel_type;  // the file's scalar type, e.g. "uint8"
   double min_value = 0.0;
   double max_value = 0.0;
 };

@@ -1,13 +1,12 @@
 #pragma once
 // A 3D image on a regular grid with its physical frame: x = origin + D·diag(spacing)·(i,j,k).
 // Index ↔ physical conversion lives here and nowhere else.
+#include <Eigen/Dense>
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
-
-#include <Eigen/Dense>
 
 namespace naris {
 

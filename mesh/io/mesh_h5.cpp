@@ -1,11 +1,11 @@
 #include "io/mesh_h5.h"
 
+#include <fmt/format.h>
+
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "io/atomic_file.h"
@@ -40,8 +40,8 @@ H5Handle make_group(hid_t parent, const char* name, const fs::path& path) {
 }
 
 // A 2D dataset [rows, cols], chunked so that large meshes stream through the library.
-void write_table(hid_t parent, const char* name, hid_t mem_type, hid_t file_type,
-                 const void* data, hsize_t rows, hsize_t cols, const fs::path& path) {
+void write_table(hid_t parent, const char* name, hid_t mem_type, hid_t file_type, const void* data,
+                 hsize_t rows, hsize_t cols, const fs::path& path) {
   const int rank = cols > 1 ? 2 : 1;
   const hsize_t dims[2] = {rows, cols};
   H5Handle space(H5Screate_simple(rank, dims, nullptr), H5Sclose);
@@ -50,9 +50,9 @@ void write_table(hid_t parent, const char* name, hid_t mem_type, hid_t file_type
     const hsize_t chunk[2] = {std::min<hsize_t>(rows, 1u << 16), cols};
     check(H5Pset_chunk(props.get(), rank, chunk), path, "set chunking");
   }
-  H5Handle set(H5Dcreate2(parent, name, file_type, space.get(), H5P_DEFAULT, props.get(),
-                          H5P_DEFAULT),
-               H5Dclose);
+  H5Handle set(
+      H5Dcreate2(parent, name, file_type, space.get(), H5P_DEFAULT, props.get(), H5P_DEFAULT),
+      H5Dclose);
   if (!set.valid()) fail("{}: cannot create dataset {}", path.string(), name);
   if (rows > 0)
     check(H5Dwrite(set.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), path, "write data");
@@ -64,11 +64,13 @@ void write_string_attribute(hid_t obj, const char* name, const std::string& valu
   H5Tset_size(type.get(), std::max<std::size_t>(1, value.size()));
   H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
   H5Handle attr(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-  check(H5Awrite(attr.get(), type.get(), value.empty() ? " " : value.c_str()), path, "write attribute");
+  check(H5Awrite(attr.get(), type.get(), value.empty() ? " " : value.c_str()), path,
+        "write attribute");
 }
 
 std::string read_string_attribute(hid_t obj, const char* name, const fs::path& path) {
-  if (H5Aexists(obj, name) <= 0) fail("{}: not a naris mesh file (no '{}' attribute)", path.string(), name);
+  if (H5Aexists(obj, name) <= 0)
+    fail("{}: not a naris mesh file (no '{}' attribute)", path.string(), name);
   H5Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
   H5Handle type(H5Aget_type(attr.get()), H5Tclose);
   std::string value(H5Tget_size(type.get()), '\0');
@@ -114,8 +116,8 @@ void write_xdmf(const HybridMesh& mesh, const fs::path& h5_path) {
     geometry();
     if (patch_dataset)
       x << "   <Attribute Name=\"patch\" AttributeType=\"Scalar\" Center=\"Cell\"><DataItem "
-        << "Dimensions=\"" << count << "\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">"
-        << h5 << ":" << patch_dataset << "</DataItem></Attribute>\n";
+        << "Dimensions=\"" << count << "\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">" << h5
+        << ":" << patch_dataset << "</DataItem></Attribute>\n";
     x << "  </Grid>\n";
   };
   x << " <Grid Name=\"mesh\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
@@ -125,8 +127,8 @@ void write_xdmf(const HybridMesh& mesh, const fs::path& h5_path) {
   x << " </Grid>\n <Grid Name=\"boundary\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
   grid("boundary_triangles", "Triangle", mesh.boundary_tris.size(), 3, "/boundary/tri",
        "/boundary/tri_patch");
-  grid("boundary_quadrilaterals", "Quadrilateral", mesh.boundary_quads.size(), 4,
-       "/boundary/quad", "/boundary/quad_patch");
+  grid("boundary_quadrilaterals", "Quadrilateral", mesh.boundary_quads.size(), 4, "/boundary/quad",
+       "/boundary/quad_patch");
   x << " </Grid>\n </Domain>\n</Xdmf>\n";
 
   const fs::path xdmf = fs::path(h5_path).replace_extension(".xdmf");
@@ -165,8 +167,8 @@ void write_mesh_h5(const HybridMesh& mesh, const fs::path& path) {
                 mesh.boundary_tris.size(), 3, path);
     write_table(boundary.get(), "tri_patch", H5T_NATIVE_INT32, H5T_STD_I32LE,
                 mesh.boundary_tri_patch.data(), mesh.boundary_tri_patch.size(), 1, path);
-    write_table(boundary.get(), "quad", H5T_NATIVE_INT32, H5T_STD_I32LE,
-                mesh.boundary_quads.data(), mesh.boundary_quads.size(), 4, path);
+    write_table(boundary.get(), "quad", H5T_NATIVE_INT32, H5T_STD_I32LE, mesh.boundary_quads.data(),
+                mesh.boundary_quads.size(), 4, path);
     write_table(boundary.get(), "quad_patch", H5T_NATIVE_INT32, H5T_STD_I32LE,
                 mesh.boundary_quad_patch.data(), mesh.boundary_quad_patch.size(), 1, path);
     cells.reset();
@@ -189,8 +191,8 @@ HybridMesh read_mesh_h5(const fs::path& path) {
     fail("{}: not a naris mesh file", path.string());
   const std::string version = read_string_attribute(file.get(), "version", path);
   if (version != std::to_string(kFormatVersion))
-    fail("{}: mesh format version {} is not supported (this naris reads version {})",
-         path.string(), version, kFormatVersion);
+    fail("{}: mesh format version {} is not supported (this naris reads version {})", path.string(),
+         version, kFormatVersion);
   HybridMesh mesh;
   std::istringstream names(read_string_attribute(file.get(), "patch_names", path));
   for (std::string line; std::getline(names, line);) mesh.patch_names.push_back(line);
@@ -201,7 +203,8 @@ HybridMesh read_mesh_h5(const fs::path& path) {
   read_table(file.get(), "boundary/tri", H5T_NATIVE_INT32, 3, mesh.boundary_tris, path);
   read_table(file.get(), "boundary/tri_patch", H5T_NATIVE_INT32, 1, mesh.boundary_tri_patch, path);
   read_table(file.get(), "boundary/quad", H5T_NATIVE_INT32, 4, mesh.boundary_quads, path);
-  read_table(file.get(), "boundary/quad_patch", H5T_NATIVE_INT32, 1, mesh.boundary_quad_patch, path);
+  read_table(file.get(), "boundary/quad_patch", H5T_NATIVE_INT32, 1, mesh.boundary_quad_patch,
+             path);
   const auto n = static_cast<NodeId>(mesh.nodes.size());
   auto check_ids = [&](const auto& cells, const char* what) {
     for (const auto& c : cells)

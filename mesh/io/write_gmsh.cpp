@@ -1,9 +1,9 @@
 #include "io/write_gmsh.h"
 
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <memory>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "io/atomic_file.h"
@@ -23,7 +23,8 @@ void write_gmsh22(const HybridMesh& mesh, const std::filesystem::path& path) {
     buf.clear();
   };
   const int fluid = static_cast<int>(mesh.patch_names.size()) + 1;
-  fmt::format_to(std::back_inserter(buf), "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n{}\n",
+  fmt::format_to(std::back_inserter(buf),
+                 "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n{}\n",
                  mesh.patch_names.size() + 1);
   for (std::size_t p = 0; p < mesh.patch_names.size(); ++p)
     fmt::format_to(std::back_inserter(buf), "2 {} \"{}\"\n", p + 1, mesh.patch_names[p]);
@@ -34,8 +35,8 @@ void write_gmsh22(const HybridMesh& mesh, const std::filesystem::path& path) {
     fmt::format_to(std::back_inserter(buf), "{} {} {} {}\n", n + 1, x[0], x[1], x[2]);
     flush(false);
   }
-  const std::size_t elements = mesh.boundary_tris.size() + mesh.boundary_quads.size() +
-                               mesh.cell_count();
+  const std::size_t elements =
+      mesh.boundary_tris.size() + mesh.boundary_quads.size() + mesh.cell_count();
   fmt::format_to(std::back_inserter(buf), "$EndNodes\n$Elements\n{}\n", elements);
   std::size_t id = 0;
   auto element = [&](int type, int physical, const auto& nodes) {

@@ -1,13 +1,14 @@
 #include "io/write_vtk.h"
 
+#include <fmt/format.h>
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkCellType.h>
 #include <vtkDoubleArray.h>
 #include <vtkIdTypeArray.h>
 #include <vtkIntArray.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkCellData.h>
 #include <vtkSTLWriter.h>
 #include <vtkSmartPointer.h>
 #include <vtkUnsignedCharArray.h>
@@ -17,8 +18,6 @@
 
 #include <cstdio>
 #include <memory>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "io/atomic_file.h"
@@ -94,9 +93,10 @@ void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
       mesh.nodes.size(), cells);
   std::uint64_t offset = 0;
   auto array = [&](const char* type, const std::string& name, int components, std::uint64_t bytes) {
-    xml += fmt::format("    <DataArray type=\"{}\"{} NumberOfComponents=\"{}\" format=\"appended\" "
-                       "offset=\"{}\"/>\n",
-                       type, name.empty() ? "" : " Name=\"" + name + "\"", components, offset);
+    xml += fmt::format(
+        "    <DataArray type=\"{}\"{} NumberOfComponents=\"{}\" format=\"appended\" "
+        "offset=\"{}\"/>\n",
+        type, name.empty() ? "" : " Name=\"" + name + "\"", components, offset);
     offset += sizeof(std::uint64_t) + bytes;
   };
   xml += "   <Points>\n";
@@ -148,7 +148,7 @@ void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
   }
   header(types_bytes);
   for (std::size_t c = 0; c < cells; ++c) {
-    types.push_back(c < mesh.tets.size() ? VTK_TETRA
+    types.push_back(c < mesh.tets.size()                          ? VTK_TETRA
                     : c < mesh.tets.size() + mesh.pyramids.size() ? VTK_PYRAMID
                                                                   : VTK_HEXAHEDRON);
     if (types.size() == kBlock || c + 1 == cells) {

@@ -1,11 +1,10 @@
 #include "mve/case_table.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <map>
 #include <numeric>
 #include <random>
-
-#include <Eigen/Dense>
 
 #include "core/error.h"
 
@@ -31,12 +30,14 @@ std::uint8_t ambiguous_faces(std::uint8_t config) {
 namespace {
 
 Polygon tri(int a, int b, int c) {
-  return {3, {static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b),
-              static_cast<std::uint8_t>(c), 0}};
+  return {3,
+          {static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b), static_cast<std::uint8_t>(c),
+           0}};
 }
 Polygon quad(int a, int b, int c, int d) {
-  return {4, {static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b),
-              static_cast<std::uint8_t>(c), static_cast<std::uint8_t>(d)}};
+  return {4,
+          {static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b), static_cast<std::uint8_t>(c),
+           static_cast<std::uint8_t>(d)}};
 }
 bool contains(const Polygon& poly, int x) {
   for (int i = 0; i < poly.size; ++i)
@@ -136,9 +137,12 @@ struct Sampler {
     for (int s = 0; s < 48; ++s) {
       std::array<double, 12> t;
       for (double& x : t) {
-        if (s < 16) x = lo + (hi - lo) * u(rng);
-        else if (s < 32) x = u(rng) < 0.5 ? lo : hi;
-        else x = std::array<double, 3>{lo, 0.5, hi}[static_cast<int>(u(rng) * 3) % 3];
+        if (s < 16)
+          x = lo + (hi - lo) * u(rng);
+        else if (s < 32)
+          x = u(rng) < 0.5 ? lo : hi;
+        else
+          x = std::array<double, 3>{lo, 0.5, hi}[static_cast<int>(u(rng) * 3) % 3];
       }
       params.push_back(t);
     }
@@ -240,8 +244,10 @@ bool cone_from(int x, const std::vector<Polygon>& face_polys, const std::vector<
     CellTemplate cell;
     const auto& p = poly.p;
     const auto ux = static_cast<std::uint8_t>(x);
-    if (poly.size == 3) cell = {4, {p[0], p[2], p[1], ux, 0}};
-    else cell = {5, {p[0], p[3], p[2], p[1], ux}};
+    if (poly.size == 3)
+      cell = {4, {p[0], p[2], p[1], ux, 0}};
+    else
+      cell = {5, {p[0], p[3], p[2], p[1], ux}};
     tess.cells.push_back(cell);
   };
   for (const auto& poly : face_polys) add_cone(poly);
@@ -339,8 +345,8 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
       const bool centre = x < 0;
       const std::vector<int>& centre_of =
           x == -2 ? inside_vertices : (x == -3 ? cloops.front() : cpoints);
-      if (!cone_from(centre ? kPrivatePoint0 : x, cpolys, cface, cloops, centre ? 0 : -1,
-                     centre_of, fan, tess))
+      if (!cone_from(centre ? kPrivatePoint0 : x, cpolys, cface, cloops, centre ? 0 : -1, centre_of,
+                     fan, tess))
         continue;
       int failures = 0;
       Points pts;
@@ -366,7 +372,7 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
 }
 
 struct Table {
-  std::vector<CaseEntry> entries;          // 256 × 64, only masks ⊆ ambiguous faces filled
+  std::vector<CaseEntry> entries;  // 256 × 64, only masks ⊆ ambiguous faces filled
   std::size_t distinct = 0;
   Table() : entries(256 * 64) {
     const Sampler sampler;
@@ -374,8 +380,8 @@ struct Table {
       const auto amb = ambiguous_faces(static_cast<std::uint8_t>(config));
       for (int mask = 0; mask < 64; ++mask) {
         if ((mask & ~amb) != 0) continue;
-        entries[static_cast<std::size_t>(config * 64 + mask)] =
-            build_entry(static_cast<std::uint8_t>(config), static_cast<std::uint8_t>(mask), sampler);
+        entries[static_cast<std::size_t>(config * 64 + mask)] = build_entry(
+            static_cast<std::uint8_t>(config), static_cast<std::uint8_t>(mask), sampler);
         ++distinct;
       }
     }
@@ -394,6 +400,8 @@ const CaseEntry& case_entry(std::uint8_t config, std::uint8_t connected) {
   return table().entries[static_cast<std::size_t>(config) * 64 + mask];
 }
 
-std::size_t case_entry_count() { return table().distinct; }
+std::size_t case_entry_count() {
+  return table().distinct;
+}
 
 }  // namespace naris::mve

@@ -24,9 +24,18 @@ inline constexpr int kPrivatePoint0 = 26;
 inline constexpr std::array<std::array<int, 3>, 8> kCorner = {
     {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}};
 // Edges as vertex pairs, each from its lower to its higher corner. Edge e runs along axis e / 4.
-inline constexpr std::array<std::array<int, 2>, 12> kEdge = {{{0, 1}, {3, 2}, {4, 5}, {7, 6},
-                                                              {0, 3}, {1, 2}, {4, 7}, {5, 6},
-                                                              {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
+inline constexpr std::array<std::array<int, 2>, 12> kEdge = {{{0, 1},
+                                                              {3, 2},
+                                                              {4, 5},
+                                                              {7, 6},
+                                                              {0, 3},
+                                                              {1, 2},
+                                                              {4, 7},
+                                                              {5, 6},
+                                                              {0, 4},
+                                                              {1, 5},
+                                                              {2, 6},
+                                                              {3, 7}}};
 // Faces −x, +x, −y, +y, −z, +z, each as a vertex cycle counter-clockwise seen from outside.
 inline constexpr std::array<std::array<int, 4>, 6> kFace = {
     {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}}};
@@ -55,8 +64,8 @@ struct Tessellation {
   std::vector<PrivatePoint> privates;  // local ids 26, 27, ... in order
   std::vector<CellTemplate> cells;
   std::vector<Polygon> iso_triangles;
-  int apex = -1;                       // local id of the cone apex
-  bool robust = false;                 // valid for every sampled isopoint placement
+  int apex = -1;        // local id of the cone apex
+  bool robust = false;  // valid for every sampled isopoint placement
 };
 
 struct Component {

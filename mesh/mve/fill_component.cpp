@@ -40,10 +40,13 @@ double place_and_measure(const Tessellation& t, Points& x) {
 void emit(const Tessellation& t, const Points& x, ComponentFill& out) {
   for (std::size_t n = 0; n < t.privates.size(); ++n) out.privates.push_back(x[kPrivatePoint0 + n]);
   for (const auto& c : t.cells) {
-    if (c.size == 4) out.tets.push_back({c.p[0], c.p[1], c.p[2], c.p[3], 0});
-    else out.pyramids.push_back(c.p);
+    if (c.size == 4)
+      out.tets.push_back({c.p[0], c.p[1], c.p[2], c.p[3], 0});
+    else
+      out.pyramids.push_back(c.p);
   }
-  for (const auto& tri : t.iso_triangles) out.iso_triangles.push_back({tri.p[0], tri.p[1], tri.p[2]});
+  for (const auto& tri : t.iso_triangles)
+    out.iso_triangles.push_back({tri.p[0], tri.p[1], tri.p[2]});
 }
 
 // No table candidate fits: look for an interior apex O and, for each isosurface loop, a cap apex
@@ -110,7 +113,9 @@ bool search_apex(const Component& comp, const Eigen::Vector3d& cube_min, const P
         return true;
       };
       for (std::size_t guess = 0; guess < n + 2 && !found; ++guess)
-        found = accept(guess == 0 ? sum : guess == 1 ? Eigen::Vector3d(centroid - o) : w[guess - 2]);
+        found = accept(guess == 0   ? sum
+                       : guess == 1 ? Eigen::Vector3d(centroid - o)
+                                    : w[guess - 2]);
       Eigen::Vector3d d = sum;
       for (int iter = 0; iter < 300 && !found; ++iter) {
         if (!(d.norm() > 0.0)) break;
@@ -144,8 +149,10 @@ bool search_apex(const Component& comp, const Eigen::Vector3d& cube_min, const P
     out.privates.push_back(o);
     for (const auto& poly : comp.face_polygons) {
       const auto& p = poly.p;
-      if (poly.size == 3) out.tets.push_back({p[0], p[2], p[1], apex, 0});
-      else out.pyramids.push_back({p[0], p[3], p[2], p[1], apex});
+      if (poly.size == 3)
+        out.tets.push_back({p[0], p[2], p[1], apex, 0});
+      else
+        out.pyramids.push_back({p[0], p[3], p[2], p[1], apex});
     }
     for (std::size_t l = 0; l < comp.loops.size(); ++l) {
       const auto g = static_cast<std::uint8_t>(kPrivatePoint0 + out.privates.size());

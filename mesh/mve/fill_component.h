@@ -2,11 +2,10 @@
 // Fills one inside component of one cube with cells, given the positions of its local points:
 // the first table candidate whose cells all have positive volume, or else an apex found by a
 // small search (see fill_component.cpp). Shared by the mesher and the table tests.
+#include <Eigen/Dense>
 #include <array>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Dense>
 
 #include "mve/case_table.h"
 

@@ -184,9 +184,15 @@ class Mesher {
     const int gi = i + kCorner[a][0], gj = j + kCorner[a][1], dz = kCorner[a][2];
     NodeId* slot;
     switch (e / 4) {
-      case 0: slot = &xedge_[dz][static_cast<std::size_t>(gi) + static_cast<std::size_t>(nx_) * gj]; break;
-      case 1: slot = &yedge_[dz][static_cast<std::size_t>(gi) + static_cast<std::size_t>(nx_) * gj]; break;
-      default: slot = &zedge_[static_cast<std::size_t>(gi) + static_cast<std::size_t>(nx_) * gj]; break;
+      case 0:
+        slot = &xedge_[dz][static_cast<std::size_t>(gi) + static_cast<std::size_t>(nx_) * gj];
+        break;
+      case 1:
+        slot = &yedge_[dz][static_cast<std::size_t>(gi) + static_cast<std::size_t>(nx_) * gj];
+        break;
+      default:
+        slot = &zedge_[static_cast<std::size_t>(gi) + static_cast<std::size_t>(nx_) * gj];
+        break;
     }
     if (*slot == kNone) {
       double t = crossing(gi, gj, dz, i + kCorner[b][0], j + kCorner[b][1], kCorner[b][2]);
@@ -202,12 +208,24 @@ class Mesher {
     NodeId* slot;
     const std::size_t row = static_cast<std::size_t>(nx_) * j;
     switch (f) {
-      case 0: slot = &xface_[i + row]; break;
-      case 1: slot = &xface_[i + 1 + row]; break;
-      case 2: slot = &yface_[i + row]; break;
-      case 3: slot = &yface_[i + row + static_cast<std::size_t>(nx_)]; break;
-      case 4: slot = &zface_[0][i + row]; break;
-      default: slot = &zface_[1][i + row]; break;
+      case 0:
+        slot = &xface_[i + row];
+        break;
+      case 1:
+        slot = &xface_[i + 1 + row];
+        break;
+      case 2:
+        slot = &yface_[i + row];
+        break;
+      case 3:
+        slot = &yface_[i + row + static_cast<std::size_t>(nx_)];
+        break;
+      case 4:
+        slot = &zface_[0][i + row];
+        break;
+      default:
+        slot = &zface_[1][i + row];
+        break;
     }
     if (*slot == kNone) *slot = add_node(0.5 * (mesh_.nodes[a] + mesh_.nodes[b]));
     return *slot;
@@ -220,12 +238,18 @@ class Mesher {
 
   bool on_border(int i, int j, int f) const {
     switch (f) {
-      case 0: return i == 0;
-      case 1: return i + 2 == nx_;
-      case 2: return j == 0;
-      case 3: return j + 2 == ny_;
-      case 4: return k_ == 0;
-      default: return k_ + 2 == nz_;
+      case 0:
+        return i == 0;
+      case 1:
+        return i + 2 == nx_;
+      case 2:
+        return j == 0;
+      case 3:
+        return j + 2 == ny_;
+      case 4:
+        return k_ == 0;
+      default:
+        return k_ + 2 == nz_;
     }
   }
 
@@ -306,7 +330,8 @@ class Mesher {
       stats_.unresolved_cubes += !fill_.resolved;
       for (std::size_t n = 0; n < fill_.privates.size(); ++n)
         ids[kPrivatePoint0 + n] = add_node(fill_.privates[n]);
-      for (const auto& t : fill_.tets) mesh_.tets.push_back({ids[t[0]], ids[t[1]], ids[t[2]], ids[t[3]]});
+      for (const auto& t : fill_.tets)
+        mesh_.tets.push_back({ids[t[0]], ids[t[1]], ids[t[2]], ids[t[3]]});
       for (const auto& p : fill_.pyramids)
         mesh_.pyramids.push_back({ids[p[0]], ids[p[1]], ids[p[2]], ids[p[3]], ids[p[4]]});
       for (const auto& t : fill_.iso_triangles) {

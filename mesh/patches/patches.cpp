@@ -71,9 +71,10 @@ CutPlane parse_cut_plane(const std::string& text) {
     plane.normal.normalize();
     return plane;
   }
-  fail("plane '{}' not understood: give a voxel-index plane such as j=20, or a physical one such "
-       "as p=0,12.5,0;n=0,1,0 (millimetres)",
-       text);
+  fail(
+      "plane '{}' not understood: give a voxel-index plane such as j=20, or a physical one such "
+      "as p=0,12.5,0;n=0,1,0 (millimetres)",
+      text);
 }
 
 bool Region::contains(const Eigen::Vector3d& x) const {
@@ -85,9 +86,10 @@ Region parse_region(const std::string& text) {
   static const std::regex form(R"(^\s*([A-Za-z_][A-Za-z0-9_-]*)\s*:\s*(box|sphere)\s*=\s*(.+)$)");
   std::smatch m;
   if (!std::regex_match(text, m, form))
-    fail("region '{}' not understood: give name:box=x0,y0,z0,x1,y1,z1 or name:sphere=x,y,z,r "
-         "(millimetres)",
-         text);
+    fail(
+        "region '{}' not understood: give name:box=x0,y0,z0,x1,y1,z1 or name:sphere=x,y,z,r "
+        "(millimetres)",
+        text);
   Region r;
   r.name = m[1].str();
   const auto v = parse_numbers(m[3].str(), text);
@@ -96,7 +98,8 @@ Region parse_region(const std::string& text) {
     r.a = Eigen::Vector3d(std::min(v[0], v[3]), std::min(v[1], v[4]), std::min(v[2], v[5]));
     r.b = Eigen::Vector3d(std::max(v[0], v[3]), std::max(v[1], v[4]), std::max(v[2], v[5]));
   } else {
-    if (v.size() != 4 || !(v[3] > 0.0)) fail("region '{}': a sphere needs x,y,z,r with r > 0", text);
+    if (v.size() != 4 || !(v[3] > 0.0))
+      fail("region '{}': a sphere needs x,y,z,r with r > 0", text);
     r.sphere = true;
     r.a = Eigen::Vector3d(v[0], v[1], v[2]);
     r.radius = v[3];
@@ -126,13 +129,14 @@ PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>&
     if (axis >= 0) {
       const int at = static_cast<int>(std::lround(index));
       if (at < 0 || at >= frame.dims[axis])
-        fail("{} plane '{}' lies outside the image (index {} of 0..{})", cut.patch,
-             cut.plane.text, at, frame.dims[axis] - 1);
+        fail("{} plane '{}' lies outside the image (index {} of 0..{})", cut.patch, cut.plane.text,
+             at, frame.dims[axis] - 1);
       if (prepared.centroid_index[axis] >= at) {
         options.crop.lo[axis] = std::max(options.crop.lo[axis], at);
         options.side_patch[2 * axis] = cut.patch;
       } else {
-        options.crop.hi[axis] = options.crop.hi[axis] < 0 ? at : std::min(options.crop.hi[axis], at);
+        options.crop.hi[axis] =
+            options.crop.hi[axis] < 0 ? at : std::min(options.crop.hi[axis], at);
         options.side_patch[2 * axis + 1] = cut.patch;
       }
       continue;
@@ -162,7 +166,8 @@ void finish_patches(HybridMesh& mesh, const mve::FieldSource& field, const std::
     const int id = mesh.add_patch(cut.patch);
     auto on_plane = [&](const auto& face) {
       for (NodeId n : face)
-        if (std::abs(cut.plane.normal.dot(mesh.nodes[n] - cut.plane.point)) > tolerance) return false;
+        if (std::abs(cut.plane.normal.dot(mesh.nodes[n] - cut.plane.point)) > tolerance)
+          return false;
       return true;
     };
     for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f)
@@ -177,9 +182,10 @@ void finish_patches(HybridMesh& mesh, const mve::FieldSource& field, const std::
     if (it == report.end() || it->faces == 0) {
       const Eigen::Vector3d& c = prepared.centroid_index;
       const Eigen::Vector3d x = field.frame().physical(c);
-      fail("the {} plane '{}' does not cut the object: no boundary face lies on it (the "
-           "object's centroid is at voxel i={:.0f} j={:.0f} k={:.0f}, {:.1f},{:.1f},{:.1f} mm)",
-           cut.patch, cut.plane.text, c[0], c[1], c[2], x[0], x[1], x[2]);
+      fail(
+          "the {} plane '{}' does not cut the object: no boundary face lies on it (the "
+          "object's centroid is at voxel i={:.0f} j={:.0f} k={:.0f}, {:.1f},{:.1f},{:.1f} mm)",
+          cut.patch, cut.plane.text, c[0], c[1], c[2], x[0], x[1], x[2]);
     }
   }
   const int from = mesh.patch_id(from_patch);
@@ -219,13 +225,15 @@ std::vector<PatchReport> patch_report(const HybridMesh& mesh) {
   for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f) {
     const auto& t = mesh.boundary_tris[f];
     const double area =
-        0.5 * (mesh.nodes[t[1]] - mesh.nodes[t[0]]).cross(mesh.nodes[t[2]] - mesh.nodes[t[0]]).norm();
+        0.5 *
+        (mesh.nodes[t[1]] - mesh.nodes[t[0]]).cross(mesh.nodes[t[2]] - mesh.nodes[t[0]]).norm();
     add_face(t, mesh.boundary_tri_patch[f], area);
   }
   for (std::size_t f = 0; f < mesh.boundary_quads.size(); ++f) {
     const auto& q = mesh.boundary_quads[f];
     const double area =
-        0.5 * (mesh.nodes[q[2]] - mesh.nodes[q[0]]).cross(mesh.nodes[q[3]] - mesh.nodes[q[1]]).norm();
+        0.5 *
+        (mesh.nodes[q[2]] - mesh.nodes[q[0]]).cross(mesh.nodes[q[3]] - mesh.nodes[q[1]]).norm();
     add_face(q, mesh.boundary_quad_patch[f], area);
   }
   // A patch's perimeter: the edges that only one of its own faces uses.

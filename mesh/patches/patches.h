@@ -1,12 +1,11 @@
 #pragma once
 // Boundary patches: the inlet and outlet as cut planes, named regions carved out of the wall,
 // and the per-patch report (area; perimeter and hydraulic diameter 4A/P).
+#include <Eigen/Dense>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Dense>
 
 #include "hybrid_mesh.h"
 #include "mve/mve.h"
@@ -17,10 +16,10 @@ namespace naris {
 struct CutPlane {
   std::string text;
   bool index_plane = false;
-  int axis = 0;        // index planes
-  double index = 0.0;  // index planes
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // physical planes
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ(); // physical planes, unit
+  int axis = 0;                                       // index planes
+  double index = 0.0;                                 // index planes
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();    // physical planes
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // physical planes, unit
 };
 CutPlane parse_cut_plane(const std::string& text);
 

@@ -1,11 +1,11 @@
 #include "pipeline/mesh_job.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -25,8 +25,7 @@ mve::VolumeField make_field(const Volume<float>& volume, const MeshJob& job, Mes
   using Mode = mve::VolumeField::Mode;
   Mode mode;
   double level;
-  if (job.threshold && job.label)
-    fail("give either --threshold or --label, not both");
+  if (job.threshold && job.label) fail("give either --threshold or --label, not both");
   if (job.label) {
     mode = Mode::label;
     level = *job.label;
@@ -42,9 +41,10 @@ mve::VolumeField make_field(const Volume<float>& volume, const MeshJob& job, Mes
                         std::all_of(volume.values.begin(), volume.values.end(),
                                     [](float v) { return v == 0.0f || v == 1.0f; });
     if (!binary)
-      fail("{}: the image is not a binary labelmap (values {} .. {}): give --threshold T (CT, "
-           "inside below T) or --label L",
-           job.input.string(), info.min_value, info.max_value);
+      fail(
+          "{}: the image is not a binary labelmap (values {} .. {}): give --threshold T (CT, "
+          "inside below T) or --label L",
+          job.input.string(), info.min_value, info.max_value);
     mode = Mode::label;
     level = 1.0;
   }
@@ -65,9 +65,10 @@ mve::VolumeField make_field(const Volume<float>& volume, const MeshJob& job, Mes
          mode == Mode::above ? "above" : "below", level);
   }
   if (inside == volume.values.size())
-    fail("{}: every voxel is inside ({} {}): the object has no boundary in the image; check the "
-         "threshold side (--inside) or crop with --inlet/--outlet",
-         job.input.string(), mode == Mode::label ? "label" : "threshold", level);
+    fail(
+        "{}: every voxel is inside ({} {}): the object has no boundary in the image; check the "
+        "threshold side (--inside) or crop with --inlet/--outlet",
+        job.input.string(), mode == Mode::label ? "label" : "threshold", level);
   r.level = level;
   r.mode = mode == Mode::label ? "label" : (mode == Mode::above ? "above" : "below");
   return mve::VolumeField(volume, mode, level);
@@ -140,9 +141,10 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
     r.check = check_mesh(r.mesh);
     r.seconds.push_back({"check", clock.seconds()});
     if (!r.check->valid())
-      fail("internal error: the mesh of {} failed its own checks ({}); please report it with "
-           "the input",
-           job.input.string(), r.check->describe());
+      fail(
+          "internal error: the mesh of {} failed its own checks ({}); please report it with "
+          "the input",
+          job.input.string(), r.check->describe());
   }
   r.seconds.push_back({"total", total.seconds()});
   return r;
@@ -182,7 +184,8 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
   std::string patches;
   for (const auto& p : r.patches)
     patches += fmt::format(
-        "{}\n    {{\"name\": \"{}\", \"faces\": {}, \"area_mm2\": {:.6g}, \"perimeter_mm\": {:.6g}, "
+        "{}\n    {{\"name\": \"{}\", \"faces\": {}, \"area_mm2\": {:.6g}, \"perimeter_mm\": "
+        "{:.6g}, "
         "\"hydraulic_diameter_mm\": {:.6g}}}",
         patches.empty() ? "" : ",", json_escape(p.name), p.faces, p.area, p.perimeter,
         p.hydraulic_diameter());
@@ -241,11 +244,12 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
   };
   s += line("quality", r.before);
   if (job.improve)
-    s += fmt::format("  improved  {} short edges collapsed ({} refused), {} cells removed, {} "
-                     "pyramids → tets\n",
-                     r.improvement.collapsed,
-                     r.improvement.refused_topology + r.improvement.refused_geometry,
-                     r.improvement.removed_cells, r.improvement.pyramids_to_tets) +
+    s += fmt::format(
+             "  improved  {} short edges collapsed ({} refused), {} cells removed, {} "
+             "pyramids → tets\n",
+             r.improvement.collapsed,
+             r.improvement.refused_topology + r.improvement.refused_geometry,
+             r.improvement.removed_cells, r.improvement.pyramids_to_tets) +
          line("after", r.after);
   if (r.check)
     s += fmt::format("  checked   conforming, watertight, all volumes > 0 (min {:.3g} mm³)\n",
@@ -254,7 +258,8 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
   for (const auto& [stage, sec] : r.seconds) times += fmt::format(" {} {:.2f}s", stage, sec);
   s += fmt::format("  time     {}\n  memory    peak {:.0f} MB\n", times,
                    static_cast<double>(peak_memory_bytes()) / 1e6);
-  if (!r.written.empty()) s += fmt::format("  wrote     {}\n", fmt::join(r.written, "\n            "));
+  if (!r.written.empty())
+    s += fmt::format("  wrote     {}\n", fmt::join(r.written, "\n            "));
   return s;
 }
 

@@ -1,19 +1,21 @@
 #include "quality/check.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
 #include <vector>
 
-#include <fmt/format.h>
-
 namespace naris {
 namespace {
 
 // Outward faces of each cell type in VTK order.
-constexpr std::array<std::array<int, 3>, 4> kTetFaces = {{{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}};
-constexpr std::array<std::array<int, 3>, 4> kPyramidTris = {{{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}};
+constexpr std::array<std::array<int, 3>, 4> kTetFaces = {
+    {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}};
+constexpr std::array<std::array<int, 3>, 4> kPyramidTris = {
+    {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}};
 constexpr std::array<int, 4> kPyramidBase = {0, 3, 2, 1};
 constexpr std::array<std::array<int, 4>, 6> kHexFaces = {
     {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}}};
@@ -49,7 +51,9 @@ bool reversed(const FaceUse& a, const FaceUse& b) {
   return true;
 }
 
-bool same(const FaceUse& a, const FaceUse& b) { return a.cycle == b.cycle; }
+bool same(const FaceUse& a, const FaceUse& b) {
+  return a.cycle == b.cycle;
+}
 
 }  // namespace
 
@@ -58,9 +62,8 @@ std::string MeshCheck::describe() const {
       "nonpositive cells {}, unmatched faces {}, misoriented pairs {}, overshared faces {}, "
       "boundary mismatches {}, open boundary edges {}, unused nodes {}, Euler cells {} "
       "boundary {}, min volume {:.3g}",
-      nonpositive_cells, unmatched_faces, misoriented_pairs, overshared_faces,
-      boundary_mismatches, open_boundary_edges, unused_nodes, euler_cells, euler_boundary,
-      min_volume);
+      nonpositive_cells, unmatched_faces, misoriented_pairs, overshared_faces, boundary_mismatches,
+      open_boundary_edges, unused_nodes, euler_cells, euler_boundary, min_volume);
 }
 
 MeshCheck check_mesh(const HybridMesh& m) {
@@ -70,7 +73,9 @@ MeshCheck check_mesh(const HybridMesh& m) {
   faces.reserve(4 * m.tets.size() + 5 * m.pyramids.size() + 6 * m.hexes.size() +
                 m.boundary_tris.size() + m.boundary_quads.size());
   std::vector<std::pair<NodeId, NodeId>> cell_edges;
-  auto add_edge = [&](NodeId a, NodeId b) { cell_edges.push_back({std::min(a, b), std::max(a, b)}); };
+  auto add_edge = [&](NodeId a, NodeId b) {
+    cell_edges.push_back({std::min(a, b), std::max(a, b)});
+  };
   auto note_volume = [&](double v) {
     r.min_volume = std::min(r.min_volume, v);
     if (!(v > 0.0)) ++r.nonpositive_cells;
@@ -140,8 +145,10 @@ MeshCheck check_mesh(const HybridMesh& m) {
       if (!reversed(faces[i], faces[i + 1])) ++r.misoriented_pairs;
       r.boundary_mismatches += static_cast<std::size_t>(bnd);
     } else if (cells == 1) {
-      if (bnd == 0) ++r.unmatched_faces;
-      else if (bnd > 1 || !same(faces[i], faces[i + 1])) ++r.boundary_mismatches;
+      if (bnd == 0)
+        ++r.unmatched_faces;
+      else if (bnd > 1 || !same(faces[i], faces[i + 1]))
+        ++r.boundary_mismatches;
     } else if (cells == 0) {
       r.boundary_mismatches += static_cast<std::size_t>(bnd);
     }
@@ -173,10 +180,9 @@ MeshCheck check_mesh(const HybridMesh& m) {
   mark(m.boundary_quads, on_boundary);
   const long nodes_used = std::count(used.begin(), used.end(), 1);
   r.unused_nodes = m.nodes.size() - static_cast<std::size_t>(nodes_used);
-  r.euler_cells = nodes_used - unique_cell_edges + unique_cell_faces -
-                  static_cast<long>(m.cell_count());
-  r.euler_boundary = std::count(on_boundary.begin(), on_boundary.end(), 1) -
-                     unique_boundary_edges +
+  r.euler_cells =
+      nodes_used - unique_cell_edges + unique_cell_faces - static_cast<long>(m.cell_count());
+  r.euler_boundary = std::count(on_boundary.begin(), on_boundary.end(), 1) - unique_boundary_edges +
                      static_cast<long>(m.boundary_tris.size() + m.boundary_quads.size());
   if (m.cell_count() == 0) r.min_volume = 0.0;
   return r;

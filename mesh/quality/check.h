@@ -12,11 +12,11 @@ namespace naris {
 
 struct MeshCheck {
   std::size_t nonpositive_cells = 0;
-  std::size_t unmatched_faces = 0;       // cell faces neither shared nor on the boundary list
-  std::size_t misoriented_pairs = 0;     // shared faces with the same orientation on both sides
-  std::size_t overshared_faces = 0;      // a face used by three or more cells
-  std::size_t boundary_mismatches = 0;   // boundary list entries that are not cell faces, or inward
-  std::size_t open_boundary_edges = 0;   // boundary edges not on exactly two boundary faces
+  std::size_t unmatched_faces = 0;      // cell faces neither shared nor on the boundary list
+  std::size_t misoriented_pairs = 0;    // shared faces with the same orientation on both sides
+  std::size_t overshared_faces = 0;     // a face used by three or more cells
+  std::size_t boundary_mismatches = 0;  // boundary list entries that are not cell faces, or inward
+  std::size_t open_boundary_edges = 0;  // boundary edges not on exactly two boundary faces
   std::size_t unused_nodes = 0;
   long euler_cells = 0;     // V − E + F − C of the cell complex
   long euler_boundary = 0;  // V − E + F of the boundary surface

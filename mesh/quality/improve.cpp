@@ -35,7 +35,8 @@ class Incidence {
     list_.resize(start_[nodes]);
     std::vector<std::size_t> fill(start_.begin(), start_.end() - 1);
     for (std::size_t i = 0; i < items.size(); ++i)
-      for (int k = 0; k < items[i].size; ++k) list_[fill[items[i].v[k]]++] = static_cast<std::int32_t>(i);
+      for (int k = 0; k < items[i].size; ++k)
+        list_[fill[items[i].v[k]]++] = static_cast<std::int32_t>(i);
   }
   template <class F>
   void for_each(NodeId n, F&& f) const {
@@ -63,7 +64,8 @@ bool has(const Face& f, NodeId n) {
 
 const std::vector<std::vector<int>>& faces_of(const Cell& c) {
   static const std::vector<std::vector<int>> tet{{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
-  static const std::vector<std::vector<int>> pyramid{{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+  static const std::vector<std::vector<int>> pyramid{
+      {0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
   static const std::vector<std::vector<int>> hex{{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
                                                  {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
   return c.size == 4 ? tet : c.size == 5 ? pyramid : hex;
@@ -81,13 +83,13 @@ double cell_shape(const Cell& c, const std::vector<Vec>& x) {
     return norms > 0.0 ? e1.cross(e2).dot(e3) / norms * std::numbers::sqrt2 : -1.0;
   };
   if (c.size == 4)
-    return std::min({corner(0, 1, 2, 3), corner(1, 2, 0, 3), corner(2, 0, 1, 3), corner(3, 0, 2, 1)});
+    return std::min(
+        {corner(0, 1, 2, 3), corner(1, 2, 0, 3), corner(2, 0, 1, 3), corner(3, 0, 2, 1)});
   // Pyramid: base corners, and every sub-tetrahedron of both base diagonals must be positive.
   const auto& v = c.v;
-  const double tets = std::min({tet6(x[v[0]], x[v[1]], x[v[2]], x[v[4]]),
-                                tet6(x[v[0]], x[v[2]], x[v[3]], x[v[4]]),
-                                tet6(x[v[0]], x[v[1]], x[v[3]], x[v[4]]),
-                                tet6(x[v[1]], x[v[2]], x[v[3]], x[v[4]])});
+  const double tets = std::min(
+      {tet6(x[v[0]], x[v[1]], x[v[2]], x[v[4]]), tet6(x[v[0]], x[v[2]], x[v[3]], x[v[4]]),
+       tet6(x[v[0]], x[v[1]], x[v[3]], x[v[4]]), tet6(x[v[1]], x[v[2]], x[v[3]], x[v[4]])});
   if (!(tets > 0.0)) return -1.0;
   return std::min({corner(0, 1, 3, 4), corner(1, 2, 0, 4), corner(2, 3, 1, 4), corner(3, 0, 2, 4)});
 }
@@ -175,7 +177,8 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
   // Candidates: short edges of tetrahedra and pyramids, shortest first.
   std::vector<std::tuple<double, NodeId, NodeId>> edges;
   static constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-  static constexpr int kPyrEdges[8][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 4}, {1, 4}, {2, 4}, {3, 4}};
+  static constexpr int kPyrEdges[8][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0},
+                                          {0, 4}, {1, 4}, {2, 4}, {3, 4}};
   for (const auto& c : cells) {
     if (c.size == 8) continue;
     auto consider = [&](NodeId a, NodeId b) {
@@ -236,8 +239,10 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
       ++stats.refused_topology;
       continue;
     }
-    if (movable(a) && !movable(b)) std::swap(a, b);
-    else if (movable(a) && movable(b) && patch[a] == -1 && patch[b] >= 0) std::swap(a, b);
+    if (movable(a) && !movable(b))
+      std::swap(a, b);
+    else if (movable(a) && movable(b) && patch[a] == -1 && patch[b] >= 0)
+      std::swap(a, b);
     // Now b moves; a stays unless both are movable with the same patch.
     if (patch[a] >= 0 && patch[b] >= 0 && patch[a] != patch[b]) {
       ++stats.refused_topology;
@@ -278,7 +283,8 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
         allowed.push_back(cell.v[4]);
       }
     }
-    auto neighbours = [&](NodeId n, const std::vector<std::int32_t>& around, std::vector<NodeId>& out) {
+    auto neighbours = [&](NodeId n, const std::vector<std::int32_t>& around,
+                          std::vector<NodeId>& out) {
       out.clear();
       for (auto c : around) {
         const Cell& cell = cells[c];
@@ -343,7 +349,8 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
           }
           for (int k = 0; k < face.size; ++k) {
             // Neighbours along the face's edges only (not across a quadrilateral's diagonal).
-            const NodeId prev = face.v[(k + face.size - 1) % face.size], next = face.v[(k + 1) % face.size];
+            const NodeId prev = face.v[(k + face.size - 1) % face.size],
+                         next = face.v[(k + 1) % face.size];
             if (face.v[k] == n) {
               out.push_back(prev);
               out.push_back(next);
@@ -387,8 +394,10 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     bool shaped = true;
     for (auto c : around_b) {
       const Cell after = collapsed(cells[c], a, b);
-      if (after.size == 8) shaped = false;
-      else if (after.size && !acceptable(cells[c], after)) shaped = false;
+      if (after.size == 8)
+        shaped = false;
+      else if (after.size && !acceptable(cells[c], after))
+        shaped = false;
     }
     if (shaped && target != xa)
       for (auto c : around_a) {
@@ -427,8 +436,10 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     for (auto c : around_b) {
       const Cell before = cells[c];
       cells[c] = collapsed(before, a, b);
-      if (!cells[c].size) ++stats.removed_cells;
-      else if (before.size == 5 && cells[c].size == 4) ++stats.pyramids_to_tets;
+      if (!cells[c].size)
+        ++stats.removed_cells;
+      else if (before.size == 5 && cells[c].size == 4)
+        ++stats.pyramids_to_tets;
     }
     node_faces.for_each(b, [&](std::int32_t f) {
       if (faces[f].size && has(faces[f], b)) faces[f] = collapsed(faces[f], a, b);
@@ -446,8 +457,10 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
   mesh.pyramids.clear();
   mesh.hexes.clear();
   for (const auto& c : cells) {
-    if (c.size == 4) mesh.tets.push_back({c.v[0], c.v[1], c.v[2], c.v[3]});
-    else if (c.size == 5) mesh.pyramids.push_back({c.v[0], c.v[1], c.v[2], c.v[3], c.v[4]});
+    if (c.size == 4)
+      mesh.tets.push_back({c.v[0], c.v[1], c.v[2], c.v[3]});
+    else if (c.size == 5)
+      mesh.pyramids.push_back({c.v[0], c.v[1], c.v[2], c.v[3], c.v[4]});
     else if (c.size == 8)
       mesh.hexes.push_back({c.v[0], c.v[1], c.v[2], c.v[3], c.v[4], c.v[5], c.v[6], c.v[7]});
   }

@@ -18,10 +18,10 @@ struct ImproveOptions {
 };
 
 struct ImproveStats {
-  std::size_t short_edges = 0;        // candidates found
+  std::size_t short_edges = 0;  // candidates found
   std::size_t collapsed = 0;
-  std::size_t refused_topology = 0;   // link condition, pinch, lateral pyramid edge, hex
-  std::size_t refused_geometry = 0;   // would invert or flatten a cell or fold the boundary
+  std::size_t refused_topology = 0;  // link condition, pinch, lateral pyramid edge, hex
+  std::size_t refused_geometry = 0;  // would invert or flatten a cell or fold the boundary
   std::size_t removed_cells = 0;
   std::size_t pyramids_to_tets = 0;
   double seconds = 0.0;

@@ -25,10 +25,17 @@ const Shape kTet{{{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}},
 const Shape kPyramid{{{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}},
                      {{{0, 1, 3, 4}}, {{1, 2, 0, 4}}, {{2, 3, 1, 4}}, {{3, 0, 2, 4}}},
                      std::numbers::sqrt2};
-const Shape kHex{{{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}},
-                 {{{0, 1, 3, 4}}, {{1, 2, 0, 5}}, {{2, 3, 1, 6}}, {{3, 0, 2, 7}},
-                  {{4, 7, 5, 0}}, {{5, 4, 6, 1}}, {{6, 5, 7, 2}}, {{7, 6, 4, 3}}},
-                 1.0};
+const Shape kHex{
+    {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}},
+    {{{0, 1, 3, 4}},
+     {{1, 2, 0, 5}},
+     {{2, 3, 1, 6}},
+     {{3, 0, 2, 7}},
+     {{4, 7, 5, 0}},
+     {{5, 4, 6, 1}},
+     {{6, 5, 7, 2}},
+     {{7, 6, 4, 3}}},
+    1.0};
 
 Vec face_normal(const std::vector<int>& f, std::span<const Vec> x) {
   if (f.size() == 3) return (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]);
@@ -48,7 +55,8 @@ CellQuality measure(const Shape& s, std::span<const Vec> x) {
       shortest = std::min(shortest, len);
       longest = std::max(longest, len);
       const double denom = a.norm() * len;
-      const double angle = denom > 0.0 ? std::acos(std::clamp(a.dot(b) / denom, -1.0, 1.0)) * kDeg : 0.0;
+      const double angle =
+          denom > 0.0 ? std::acos(std::clamp(a.dot(b) / denom, -1.0, 1.0)) * kDeg : 0.0;
       amax = std::max(amax, angle);
       amin = std::min(amin, angle);
     }
@@ -62,12 +70,12 @@ CellQuality measure(const Shape& s, std::span<const Vec> x) {
   for (std::size_t f = 0; f < s.faces.size(); ++f)
     for (std::size_t g = f + 1; g < s.faces.size(); ++g) {
       int shared = 0;
-      for (int a : s.faces[f])
-        shared += std::count(s.faces[g].begin(), s.faces[g].end(), a) > 0;
+      for (int a : s.faces[f]) shared += std::count(s.faces[g].begin(), s.faces[g].end(), a) > 0;
       if (shared != 2) continue;
       const Vec n1 = face_normal(s.faces[f], x), n2 = face_normal(s.faces[g], x);
       const double d = n1.norm() * n2.norm();
-      const double between = d > 0.0 ? std::acos(std::clamp(n1.dot(n2) / d, -1.0, 1.0)) * kDeg : 180.0;
+      const double between =
+          d > 0.0 ? std::acos(std::clamp(n1.dot(n2) / d, -1.0, 1.0)) * kDeg : 180.0;
       min_dihedral = std::min(min_dihedral, 180.0 - between);
     }
   q.min_dihedral = static_cast<float>(min_dihedral);
@@ -93,20 +101,28 @@ double percentile(std::vector<float>& v, double p) {
 
 const char* metric_name(Metric m) {
   switch (m) {
-    case Metric::edge_ratio: return "edge_ratio";
-    case Metric::equiangle_skew: return "equiangle_skew";
-    case Metric::min_dihedral: return "min_dihedral_deg";
-    case Metric::scaled_jacobian: return "scaled_jacobian";
+    case Metric::edge_ratio:
+      return "edge_ratio";
+    case Metric::equiangle_skew:
+      return "equiangle_skew";
+    case Metric::min_dihedral:
+      return "min_dihedral_deg";
+    case Metric::scaled_jacobian:
+      return "scaled_jacobian";
   }
   return "";
 }
 
 float CellQuality::get(Metric m) const {
   switch (m) {
-    case Metric::edge_ratio: return edge_ratio;
-    case Metric::equiangle_skew: return equiangle_skew;
-    case Metric::min_dihedral: return min_dihedral;
-    case Metric::scaled_jacobian: return scaled_jacobian;
+    case Metric::edge_ratio:
+      return edge_ratio;
+    case Metric::equiangle_skew:
+      return equiangle_skew;
+    case Metric::min_dihedral:
+      return min_dihedral;
+    case Metric::scaled_jacobian:
+      return scaled_jacobian;
   }
   return 0.0f;
 }
@@ -151,10 +167,18 @@ QualityReport summarize_quality(const HybridMesh& mesh, const std::vector<CellQu
       s.p99 = percentile(v, 0.99);
       // Fixed ranges so histograms before and after improvement compare bin by bin.
       switch (kMetrics[m]) {
-        case Metric::edge_ratio: s.lo = 1.0, s.hi = 11.0; break;
-        case Metric::equiangle_skew: s.lo = 0.0, s.hi = 1.0; break;
-        case Metric::min_dihedral: s.lo = 0.0, s.hi = 180.0; break;
-        case Metric::scaled_jacobian: s.lo = -1.0, s.hi = 1.0; break;
+        case Metric::edge_ratio:
+          s.lo = 1.0, s.hi = 11.0;
+          break;
+        case Metric::equiangle_skew:
+          s.lo = 0.0, s.hi = 1.0;
+          break;
+        case Metric::min_dihedral:
+          s.lo = 0.0, s.hi = 180.0;
+          break;
+        case Metric::scaled_jacobian:
+          s.lo = -1.0, s.hi = 1.0;
+          break;
       }
       s.histogram.assign(static_cast<std::size_t>(bins), 0);
       for (float x : v) {

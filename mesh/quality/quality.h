@@ -29,7 +29,7 @@ std::vector<CellQuality> cell_quality(const HybridMesh& mesh);
 struct MetricSummary {
   std::size_t count = 0;
   double min = 0, p1 = 0, p5 = 0, p50 = 0, p95 = 0, p99 = 0, max = 0;
-  double lo = 0, hi = 0;             // histogram range
+  double lo = 0, hi = 0;               // histogram range
   std::vector<std::size_t> histogram;  // equal bins over [lo, hi]
 };
 

@@ -1,7 +1,6 @@
 // The command line against bad input: each case must print one line `naris: error: ...` that
 // names the problem, exit non-zero, and leave no output file behind.
 #include <gtest/gtest.h>
-
 #include <sys/wait.h>
 
 #include <cmath>
@@ -34,7 +33,8 @@ class Cli : public ::testing::Test {
 
   CliRun naris(const std::string& args) {
     const fs::path err = dir_ / "stderr.txt";
-    const std::string cmd = std::string(NARIS_BINARY) + " " + args + " 2> " + err.string() + " > /dev/null";
+    const std::string cmd =
+        std::string(NARIS_BINARY) + " " + args + " 2> " + err.string() + " > /dev/null";
     CliRun r;
     const int raw = std::system(cmd.c_str());
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -90,8 +90,8 @@ TEST_F(Cli, MeshesABallAndWritesEveryFile) {
   const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
   const CliRun r = naris("mesh " + in.string() + " " + out());
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* f : {"mesh.h5", "mesh.xdmf", "mesh.vtu", "boundary.vtp", "surface.stl",
-                        "mesh.msh", "mesh.json"})
+  for (const char* f :
+       {"mesh.h5", "mesh.xdmf", "mesh.vtu", "boundary.vtp", "surface.stl", "mesh.msh", "mesh.json"})
     EXPECT_TRUE(fs::exists(dir_ / "out" / f)) << f;
   EXPECT_NE(r.err.find("conforming, watertight"), std::string::npos) << r.err;
 }
@@ -133,7 +133,8 @@ TEST_F(Cli, EmptySegmentation) {
 
 TEST_F(Cli, EverythingInside) {
   const fs::path in = nrrd("full.nrrd", "uint8", "12 12 12", std::string(12 * 12 * 12, '\1'));
-  expect_clean_failure(naris("mesh " + in.string() + " --label 1 " + out()), "every voxel is inside");
+  expect_clean_failure(naris("mesh " + in.string() + " --label 1 " + out()),
+                       "every voxel is inside");
 }
 
 TEST_F(Cli, NanValues) {

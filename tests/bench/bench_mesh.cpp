@@ -6,6 +6,7 @@
 // is timed separately.
 //
 // Usage: bench_mesh [--max N] [--no-write] [--out DIR]
+#include <fmt/format.h>
 #include <vtkDiscreteFlyingEdges3D.h>
 #include <vtkImageData.h>
 #include <vtkPointData.h>
@@ -20,8 +21,6 @@
 #include <fstream>
 #include <string>
 
-#include <fmt/format.h>
-
 #include "core/log.h"
 #include "io/mesh_h5.h"
 #include "io/write_vtk.h"
@@ -34,7 +33,9 @@ namespace {
 
 using namespace naris;
 
-void reset_peak_memory() { std::ofstream("/proc/self/clear_refs") << "5"; }
+void reset_peak_memory() {
+  std::ofstream("/proc/self/clear_refs") << "5";
+}
 
 std::size_t current_memory_bytes() {
   std::ifstream status("/proc/self/status");
@@ -58,9 +59,12 @@ int main(int argc, char** argv) {
   bool write = true;
   std::filesystem::path out = std::filesystem::temp_directory_path() / "naris-bench-mesh";
   for (int a = 1; a < argc; ++a) {
-    if (!std::strcmp(argv[a], "--max") && a + 1 < argc) max_n = std::atoi(argv[++a]);
-    else if (!std::strcmp(argv[a], "--no-write")) write = false;
-    else if (!std::strcmp(argv[a], "--out") && a + 1 < argc) out = argv[++a];
+    if (!std::strcmp(argv[a], "--max") && a + 1 < argc)
+      max_n = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--no-write"))
+      write = false;
+    else if (!std::strcmp(argv[a], "--out") && a + 1 < argc)
+      out = argv[++a];
   }
   set_verbosity(Verbosity::quiet);
   // Both meshers on one core: VTK's filters would otherwise use every core through its SMP
@@ -79,8 +83,8 @@ int main(int argc, char** argv) {
   }
 
   std::printf("%-12s %9s %9s %8s %9s %9s %8s %9s %8s %8s %6s %8s %8s %8s %8s\n", "mortar", "hex",
-              "pyramid", "tet", "nodes", "MVE s", "Mcell/s", "peak MB", "FE s", "MVE/FE",
-              "valid", "ER p99", "skew p99", "SJ min", "write s");
+              "pyramid", "tet", "nodes", "MVE s", "Mcell/s", "peak MB", "FE s", "MVE/FE", "valid",
+              "ER p99", "skew p99", "SJ min", "write s");
   const int sizes[][3] = {{16, 16, 8},    {32, 32, 16},    {64, 64, 32},   {128, 128, 64},
                           {192, 192, 96}, {256, 256, 128}, {512, 512, 256}};
   for (const auto& s : sizes) {
@@ -135,17 +139,19 @@ int main(int argc, char** argv) {
       write_vtu(mesh, out / "mesh.vtu");
       write_seconds = clock.seconds();
     }
-    std::printf("%4dx%3dx%3d %9zu %9zu %8zu %9zu %9.3f %8.2f %9.0f %8.3f %8.2f %6s %8.2f %8.2f "
-                "%8.3f %8.2f\n",
-                s[0], s[1], s[2], mesh.hexes.size(), mesh.pyramids.size(), mesh.tets.size(),
-                mesh.nodes.size(), mve_seconds, static_cast<double>(mesh.cell_count()) / mve_seconds / 1e6,
-                peak_mb, fe_seconds, mve_seconds / fe_seconds, valid.c_str(), q.summary[3][0].p99,
-                q.summary[3][1].p99, q.summary[3][3].min, write_seconds);
+    std::printf(
+        "%4dx%3dx%3d %9zu %9zu %8zu %9zu %9.3f %8.2f %9.0f %8.3f %8.2f %6s %8.2f %8.2f "
+        "%8.3f %8.2f\n",
+        s[0], s[1], s[2], mesh.hexes.size(), mesh.pyramids.size(), mesh.tets.size(),
+        mesh.nodes.size(), mve_seconds, static_cast<double>(mesh.cell_count()) / mve_seconds / 1e6,
+        peak_mb, fe_seconds, mve_seconds / fe_seconds, valid.c_str(), q.summary[3][0].p99,
+        q.summary[3][1].p99, q.summary[3][3].min, write_seconds);
     std::fflush(stdout);
   }
-  std::printf("\nMVE s: meshing from the in-memory volume on one core (keep-largest included); "
-              "FE s: vtkDiscreteFlyingEdges3D\n(surface only) on the same volume; peak MB: "
-              "resident peak during meshing, input included; ER/skew/SJ: edge ratio,\n"
-              "equi-angle skew, scaled Jacobian over all cells; write s: mesh.h5 + mesh.vtu.\n");
+  std::printf(
+      "\nMVE s: meshing from the in-memory volume on one core (keep-largest included); "
+      "FE s: vtkDiscreteFlyingEdges3D\n(surface only) on the same volume; peak MB: "
+      "resident peak during meshing, input included; ER/skew/SJ: edge ratio,\n"
+      "equi-angle skew, scaled Jacobian over all cells; write s: mesh.h5 + mesh.vtu.\n");
   return 0;
 }

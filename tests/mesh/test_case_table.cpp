@@ -2,14 +2,13 @@
 // outcome (including outcomes no trilinear data can produce), with random isopoint placements.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
 #include <set>
 #include <tuple>
-
-#include <Eigen/Dense>
 
 #include "mve/case_table.h"
 #include "mve/fill_component.h"
@@ -175,9 +174,10 @@ TEST(CaseTable, EveryConfigurationFillsItsRegionForRandomVertexValues) {
       EXPECT_GT(seen_separated[fc], 0) << "config " << config << " face " << fc;
     }
   }
-  std::printf("[ info ] %zu (configuration, saddle outcome) pairs realized of %zu table entries; "
-              "%zu of %zu samples unresolved\n",
-              realized.size() + 1, case_entry_count(), unresolved, samples);
+  std::printf(
+      "[ info ] %zu (configuration, saddle outcome) pairs realized of %zu table entries; "
+      "%zu of %zu samples unresolved\n",
+      realized.size() + 1, case_entry_count(), unresolved, samples);
   EXPECT_EQ(unresolved, 0u);
 }
 
@@ -192,8 +192,8 @@ TEST(CaseTable, SharedFacesAreTessellatedIdenticallyFromBothSides) {
               origin[2] + kCorner[local][2], 0};
     if (local < kFacePoint0) {
       const int e = local - kEdgePoint0, a = kEdge[e][0];
-      return {'e', origin[0] + kCorner[a][0], origin[1] + kCorner[a][1],
-              origin[2] + kCorner[a][2], e / 4};
+      return {'e', origin[0] + kCorner[a][0], origin[1] + kCorner[a][1], origin[2] + kCorner[a][2],
+              e / 4};
     }
     const int f = local - kFacePoint0;
     std::array<int, 3> o = origin;
@@ -217,7 +217,8 @@ TEST(CaseTable, SharedFacesAreTessellatedIdenticallyFromBothSides) {
         std::uint8_t cb = 0;
         int bit = 0;
         for (int v = 0; v < 8; ++v) {
-          const bool on_shared = std::find(kFace[fb].begin(), kFace[fb].end(), v) != kFace[fb].end();
+          const bool on_shared =
+              std::find(kFace[fb].begin(), kFace[fb].end(), v) != kFace[fb].end();
           bool inside;
           if (on_shared) {
             std::array<int, 3> p{kCorner[v][0], kCorner[v][1], kCorner[v][2]};

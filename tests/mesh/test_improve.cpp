@@ -76,7 +76,9 @@ TEST(Quality, IdealCellsScoreIdeal) {
   m.pyramids.push_back({0, 1, 2, 3, 4});
   m.hexes.push_back({0, 1, 2, 3, 5, 6, 7, 8});
   HybridMesh t;
-  t.nodes = {{0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0},
+  t.nodes = {{0, 0, 0},
+             {1, 0, 0},
+             {0.5, std::sqrt(3.0) / 2, 0},
              {0.5, std::sqrt(3.0) / 6, std::sqrt(2.0 / 3.0)}};
   t.tets.push_back({0, 1, 2, 3});
   for (const HybridMesh* mesh : {&m, &t})

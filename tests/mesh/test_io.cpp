@@ -1,15 +1,14 @@
 // Output files: the HDF5 round trip, the XDMF sidecar, VTU/VTP/STL read back by VTK, and the
 // Gmsh file's sections and physical groups.
 #include <gtest/gtest.h>
-
-#include <vtkSTLReader.h>
-#include <vtkSmartPointer.h>
-#include <vtkUnstructuredGrid.h>
-#include <vtkXMLUnstructuredGridReader.h>
 #include <vtkCellData.h>
 #include <vtkCellType.h>
 #include <vtkDataArray.h>
 #include <vtkPolyData.h>
+#include <vtkSTLReader.h>
+#include <vtkSmartPointer.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridReader.h>
 
 #include <filesystem>
 #include <fstream>
@@ -31,7 +30,8 @@ HybridMesh sample_mesh() {
   for (int k = 0; k < 7; ++k)
     for (int j = 0; j < 8; ++j)
       for (int i = 0; i < 9; ++i)
-        f.at(i, j, k) = static_cast<float>(3.2 - (Eigen::Vector3d(i, j, k) - Eigen::Vector3d(4.1, 3.7, 3.3)).norm());
+        f.at(i, j, k) = static_cast<float>(
+            3.2 - (Eigen::Vector3d(i, j, k) - Eigen::Vector3d(4.1, 3.7, 3.3)).norm());
   return mve::march_volume_elements(f, testing::quiet_options());
 }
 

@@ -66,8 +66,7 @@ TEST(MveCube, EveryPairOfFaceSharingCubesIsConforming) {
         ArrayField field(dims[0], dims[1], dims[2]);
         fill_pattern(field, pattern, rng);
         mve::MveStats stats;
-        const HybridMesh mesh =
-            mve::march_volume_elements(field, testing::quiet_options(), &stats);
+        const HybridMesh mesh = mve::march_volume_elements(field, testing::quiet_options(), &stats);
         expect_valid(mesh, "axis " + std::to_string(axis) + " pattern " + std::to_string(pattern));
         ASSERT_EQ(stats.unresolved_cubes, 0u);
       }

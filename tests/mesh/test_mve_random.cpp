@@ -30,7 +30,8 @@ ArrayField random_field(std::mt19937& rng, std::array<int, 3> dims, int smoothin
             for (int dj = -1; dj <= 1; ++dj)
               for (int di = -1; di <= 1; ++di) {
                 const int a = i + di, b = j + dj, c = k + dk;
-                if (a < 0 || b < 0 || c < 0 || a >= dims[0] || b >= dims[1] || c >= dims[2]) continue;
+                if (a < 0 || b < 0 || c < 0 || a >= dims[0] || b >= dims[1] || c >= dims[2])
+                  continue;
                 s += v[f.index(a, b, c)];
                 ++n;
               }
@@ -38,8 +39,8 @@ ArrayField random_field(std::mt19937& rng, std::array<int, 3> dims, int smoothin
         }
     v.swap(w);
   }
-  const float shift = std::uniform_real_distribution<float>(-0.2f, 0.2f)(rng) /
-                      static_cast<float>(1 + smoothing);
+  const float shift =
+      std::uniform_real_distribution<float>(-0.2f, 0.2f)(rng) / static_cast<float>(1 + smoothing);
   for (int k = 0; k < dims[2]; ++k)
     for (int j = 0; j < dims[1]; ++j)
       for (int i = 0; i < dims[0]; ++i) field.at(i, j, k) = v[field.frame().index(i, j, k)] + shift;

@@ -21,12 +21,13 @@ SphereResult mesh_sphere(double radius, double h) {
   testing::ArrayField field(n, n, n);
   field.mutable_frame().spacing = Eigen::Vector3d::Constant(h);
   // Centre off the grid's symmetry so that no isopoint sits at a special place.
-  const Eigen::Vector3d centre = Eigen::Vector3d::Constant(0.5 * (n - 1) * h) +
-                                 Eigen::Vector3d(0.31, -0.17, 0.23) * h;
+  const Eigen::Vector3d centre =
+      Eigen::Vector3d::Constant(0.5 * (n - 1) * h) + Eigen::Vector3d(0.31, -0.17, 0.23) * h;
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i)
-        field.at(i, j, k) = static_cast<float>(radius - (Eigen::Vector3d(i, j, k) * h - centre).norm());
+        field.at(i, j, k) =
+            static_cast<float>(radius - (Eigen::Vector3d(i, j, k) * h - centre).norm());
   const HybridMesh mesh = mve::march_volume_elements(field, testing::quiet_options());
   EXPECT_TRUE(check_mesh(mesh).valid());
   const double exact = 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;

@@ -36,10 +36,20 @@ TEST(Neonate, MeshesIntoOneConformingWatertightComponentWithInletAndOutlet) {
   EXPECT_NEAR(inlet, 22.5, 0.05 * 22.5);
   EXPECT_GT(outlet, 0.0);
   EXPECT_NEAR(mesh_volume(r.mesh) / 1000.0, 4.1, 0.2);
-  std::printf("[ info ] neonate: %zu cells (%zu hex, %zu pyramid, %zu tet), %zu nodes, inlet "
-              "%.2f mm², outlet %.2f mm², %zu components\n",
-              r.mesh.cell_count(), r.mesh.hexes.size(), r.mesh.pyramids.size(), r.mesh.tets.size(),
-              r.mesh.nodes.size(), inlet, outlet, r.mve.components);
+  // The frame is rotated and mirrored (LPS): every node maps back inside the crop box.
+  const Volume<float> image = read_volume(data);
+  for (const auto& x : r.mesh.nodes) {
+    const Eigen::Vector3d ijk = image.frame.continuous_index(x);
+    ASSERT_GE(ijk[1], 19.0 - 1e-9);
+    ASSERT_LE(ijk[1], 285.0 + 1e-9);
+    ASSERT_GE(ijk[0], -1e-9);
+    ASSERT_LE(ijk[0], 46.0 + 1e-9);
+  }
+  std::printf(
+      "[ info ] neonate: %zu cells (%zu hex, %zu pyramid, %zu tet), %zu nodes, inlet "
+      "%.2f mm², outlet %.2f mm², %zu components\n",
+      r.mesh.cell_count(), r.mesh.hexes.size(), r.mesh.pyramids.size(), r.mesh.tets.size(),
+      r.mesh.nodes.size(), inlet, outlet, r.mve.components);
 }
 
 }  // namespace

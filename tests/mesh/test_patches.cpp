@@ -75,8 +75,8 @@ TEST(Patches, PipeEndsGiveCircularInletAndOutlet) {
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i)
         f.at(i, j, k) = static_cast<float>(r - std::hypot(i - 21.3, j - 21.7));
-  const HybridMesh m = mesh_with_cuts(f, {{"inlet", parse_cut_plane("k=0")},
-                                          {"outlet", parse_cut_plane("k=29")}});
+  const HybridMesh m =
+      mesh_with_cuts(f, {{"inlet", parse_cut_plane("k=0")}, {"outlet", parse_cut_plane("k=29")}});
   EXPECT_TRUE(check_mesh(m).valid());
   const auto report = patch_report(m);
   for (const char* name : {"inlet", "outlet"}) {
@@ -112,7 +112,8 @@ TEST(Patches, ObliquePlaneFacesLieOnThePlaneAndConverge) {
       for (int j = 0; j < size; ++j)
         for (int i = 0; i < size; ++i)
           f.at(i, j, k) = static_cast<float>(10.0 - (Eigen::Vector3d(i, j, k) * h - c).norm());
-    const HybridMesh m = mesh_with_cuts(f, {{"outlet", parse_cut_plane("p=12.6,12.3,12.8;n=1,1,0.5")}});
+    const HybridMesh m =
+        mesh_with_cuts(f, {{"outlet", parse_cut_plane("p=12.6,12.3,12.8;n=1,1,0.5")}});
     const MeshCheck check = check_mesh(m);
     ASSERT_TRUE(check.valid()) << check.describe();
     const int id = m.patch_id("outlet");
@@ -140,8 +141,7 @@ TEST(Patches, PlaneThatMissesTheObjectIsAnError) {
 
 TEST(Patches, RegionsAreCarvedOutOfTheWall) {
   const ArrayField f = ball(24, 9.0, {11.5, 11.5, 11.5});
-  const HybridMesh m =
-      mesh_with_cuts(f, {}, {parse_region("cap:box=-1,-1,17,30,30,30")});
+  const HybridMesh m = mesh_with_cuts(f, {}, {parse_region("cap:box=-1,-1,17,30,30,30")});
   EXPECT_TRUE(check_mesh(m).valid());
   const auto report = patch_report(m);
   const auto& cap = find(report, "cap");

@@ -1,4 +1,11 @@
 #include <gtest/gtest.h>
+#include <vtkFloatArray.h>
+#include <vtkImageData.h>
+#include <vtkMetaImageWriter.h>
+#include <vtkNIFTIImageWriter.h>
+#include <vtkPointData.h>
+#include <vtkSmartPointer.h>
+#include <vtkXMLImageDataWriter.h>
 
 #include <filesystem>
 #include <fstream>
@@ -30,6 +37,53 @@ TEST(ReadVolume, ReadsTheNeonateSegmentationWithItsFrame) {
   EXPECT_GT(airway, 99390u);
   const double voxel_ml = v.frame.spacing.prod() / 1000.0;
   EXPECT_NEAR(static_cast<double>(airway) * voxel_ml, 4.1, 0.2);
+}
+
+// A 7×5×4 float image with distinct values, spacing and origin, written by VTK's own writers.
+vtkSmartPointer<vtkImageData> sample_image() {
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(7, 5, 4);
+  image->SetSpacing(0.5, 0.25, 2.0);
+  image->SetOrigin(-3.0, 1.5, 10.0);
+  auto values = vtkSmartPointer<vtkFloatArray>::New();
+  values->SetNumberOfTuples(7 * 5 * 4);
+  for (vtkIdType n = 0; n < 140; ++n) values->SetValue(n, static_cast<float>(n) * 1.5f - 40.0f);
+  image->GetPointData()->SetScalars(values);
+  return image;
+}
+
+void expect_sample(const Volume<float>& v) {
+  EXPECT_EQ(v.dims(), (std::array<int, 3>{7, 5, 4}));
+  EXPECT_NEAR(v.frame.spacing[0], 0.5, 1e-6);
+  EXPECT_NEAR(v.frame.spacing[1], 0.25, 1e-6);
+  EXPECT_NEAR(v.frame.spacing[2], 2.0, 1e-6);
+  EXPECT_NEAR(v.frame.origin[0], -3.0, 1e-6);
+  EXPECT_NEAR(v.frame.origin[2], 10.0, 1e-6);
+  for (int n = 0; n < 140; ++n) EXPECT_EQ(v.values[static_cast<std::size_t>(n)], n * 1.5f - 40.0f);
+}
+
+template <class Writer>
+void round_trip(const char* name) {
+  const fs::path p = fs::temp_directory_path() / name;
+  auto writer = vtkSmartPointer<Writer>::New();
+  writer->SetInputData(sample_image());
+  writer->SetFileName(p.c_str());
+  writer->Write();
+  VolumeInfo info;
+  expect_sample(read_volume(p, &info));
+  EXPECT_EQ(info.pixel_type, "float");
+  fs::remove(p);
+  fs::remove(fs::path(p).replace_extension(".raw"));
+}
+
+TEST(ReadVolume, NiftiRoundTrip) {
+  round_trip<vtkNIFTIImageWriter>("naris-sample.nii");
+}
+TEST(ReadVolume, MetaImageRoundTrip) {
+  round_trip<vtkMetaImageWriter>("naris-sample.mha");
+}
+TEST(ReadVolume, VtiRoundTrip) {
+  round_trip<vtkXMLImageDataWriter>("naris-sample.vti");
 }
 
 TEST(ReadVolume, MissingFileIsAClearError) {
