@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "core/big_allocator.h"
+#include "core/big_vector.h"
 
 namespace naris {
 

@@ -360,6 +360,19 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
     std::stable_sort(ranked.begin(), ranked.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
     Component comp;
+    {
+      std::array<double, 12> mid;
+      mid.fill(0.5);
+      Points pts;
+      sample_points(entry, mid, pts);
+      for (std::size_t r = 0; r < std::min<std::size_t>(ranked.size(), 6); ++r) {
+        Points copy = pts;
+        if (min_cell_volume(ranked[r].second, copy) > 1e-12) {
+          comp.midpoint_candidate = static_cast<int>(r);
+          break;
+        }
+      }
+    }
     comp.face_polygons = cpolys;
     for (const auto& loop : cloops) comp.loops.emplace_back(loop.begin(), loop.end());
     for (auto& r : ranked) {

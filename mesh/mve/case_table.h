@@ -76,6 +76,9 @@ struct Component {
   // fits (rare: components with two or more isosurface loops and extreme isopoints).
   std::vector<Polygon> face_polygons;
   std::vector<std::vector<std::uint8_t>> loops;  // outward oriented
+  // The first candidate valid when every isopoint is an edge midpoint (binary fields), where a
+  // cube's shape depends on its configuration alone; -1 if none (then chosen at run time).
+  int midpoint_candidate = -1;
 };
 
 struct CaseEntry {

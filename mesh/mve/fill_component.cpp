@@ -193,4 +193,19 @@ void fill_component(const Component& comp, const Eigen::Vector3d& cube_min, Poin
   emit(*least_bad, x, out);
 }
 
+void fill_component_binary(const Component& comp, const Eigen::Vector3d& cube_min, Points& x,
+                           ComponentFill& out) {
+  if (comp.midpoint_candidate < 0) return fill_component(comp, cube_min, x, out);
+  out.clear();
+  const Tessellation& t = comp.candidates[static_cast<std::size_t>(comp.midpoint_candidate)];
+  int next = kPrivatePoint0;
+  for (const auto& pp : t.privates) {
+    Eigen::Vector3d m = Eigen::Vector3d::Zero();
+    for (auto s : pp.mean_of) m += x[s];
+    x[next++] = m / static_cast<double>(pp.mean_of.size());
+  }
+  out.used_fallback = comp.midpoint_candidate != 0;
+  emit(t, x, out);
+}
+
 }  // namespace naris::mve

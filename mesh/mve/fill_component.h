@@ -37,4 +37,9 @@ struct ComponentFill {
 void fill_component(const Component& comp, const Eigen::Vector3d& cube_min,
                     std::array<Eigen::Vector3d, kMaxLocalPoints>& x, ComponentFill& out);
 
+// For binary fields: the candidate known in advance to be valid at midpoint isopoints (its
+// private points are still placed from x). Falls back to fill_component when there is none.
+void fill_component_binary(const Component& comp, const Eigen::Vector3d& cube_min,
+                           std::array<Eigen::Vector3d, kMaxLocalPoints>& x, ComponentFill& out);
+
 }  // namespace naris::mve

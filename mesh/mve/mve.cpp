@@ -60,6 +60,8 @@ class Mesher {
     yface_.assign(plane, kNone);
     raw_.resize(static_cast<std::size_t>(dims[0]) * dims[1]);
     wall_ = mesh_.add_patch(opt_.wall_patch);
+    binary_ = field.binary() && opt_.clip_planes.empty();
+    track_components_ = opt_.keep_largest_component;
     for (int s = 0; s < 6; ++s) side_[s] = -1;
   }
 
@@ -91,7 +93,6 @@ class Mesher {
           continue;
         for (int i = 0; i + 1 < nx_; ++i) mesh_cube(i, j);
       }
-      reserve_ahead(k + 1);
       progress.update(static_cast<std::size_t>(k + 1));
     }
   }
@@ -148,31 +149,37 @@ class Mesher {
     return a_inside ? t : 1.0 - t;
   }
 
-  // The final sizes are unknown while streaming: extrapolate from the slabs done so far so
-  // that the arrays grow a few times early instead of being copied at every doubling.
-  void reserve_ahead(int layers_done) {
-    const double scale = 1.1 * (nz_ - 1) / layers_done;
-    auto grow = [&](auto& v) {
-      const auto want = static_cast<std::size_t>(scale * static_cast<double>(v.size()));
-      if (v.capacity() < want && want > v.size() + v.size() / 8) v.reserve(want);
-    };
-    grow(mesh_.nodes);
-    grow(mesh_.hexes);
-    grow(mesh_.tets);
-    grow(mesh_.pyramids);
-    grow(mesh_.boundary_tris);
-    grow(mesh_.boundary_tri_patch);
-  }
-
   float value(int i, int j, int dz) const {
     return value_[dz][static_cast<std::size_t>(i) + static_cast<std::size_t>(nx_) * j];
   }
 
   NodeId add_node(const Eigen::Vector3d& x) {
     mesh_.nodes.push_back(x);
-    return static_cast<NodeId>(mesh_.nodes.size() - 1);
+    const auto id = static_cast<NodeId>(mesh_.nodes.size() - 1);
+    if (track_components_) parent_.push_back(id);
+    return id;
   }
 
+  // Connected components by union-find over nodes, built while cells are made (the nodes of a
+  // new cell were made recently, so this pass stays in cache).
+  NodeId find(NodeId a) {
+    while (parent_[a] != a) a = parent_[a] = parent_[parent_[a]];
+    return a;
+  }
+  template <class Cell>
+  void unite(const Cell& c) {
+    if (!track_components_) return;
+    const NodeId r = find(c[0]);
+    for (std::size_t k = 1; k < c.size(); ++k) {
+      const NodeId q = find(c[k]);
+      if (q != r) parent_[q] = r;
+    }
+  }
+
+ public:
+  BigVector<NodeId>& parents() { return parent_; }
+
+ private:
   NodeId vertex_node(int i, int j, int dz) {
     NodeId& id = vertex_[dz][static_cast<std::size_t>(i) + static_cast<std::size_t>(nx_) * j];
     if (id == kNone) id = add_node(Eigen::Vector3d(i, j, k_ + dz));
@@ -285,6 +292,17 @@ class Mesher {
       for (int v = 0; v < 8; ++v)
         hex[v] = ids[v] = vertex_node(i + kCorner[v][0], j + kCorner[v][1], kCorner[v][2]);
       mesh_.hexes.push_back(hex);
+      // Each of the hexahedron's 12 grid edges is owned by the cube whose vertex 0 is its lower
+      // end; that cube is a hexahedron uniting its edges 0-1, 0-3, 0-4, or a boundary cube whose
+      // cells contain every inside edge. So three unions suffice, except on the grid's upper
+      // borders, where an owner cube may not exist.
+      if (i + 2 < nx_ && j + 2 < ny_ && k_ + 2 < nz_) {
+        unite(std::array<NodeId, 2>{hex[0], hex[1]});
+        unite(std::array<NodeId, 2>{hex[0], hex[3]});
+        unite(std::array<NodeId, 2>{hex[0], hex[4]});
+      } else {
+        unite(hex);
+      }
       if (i == 0 || j == 0 || k_ == 0 || i + 2 == nx_ || j + 2 == ny_ || k_ + 2 == nz_)
         add_border_faces(i, j, case_entry(255, 0), ids);
       return;
@@ -325,15 +343,22 @@ class Mesher {
 
     const Eigen::Vector3d cube_min(i, j, k_);
     for (const auto& comp : entry.components) {
-      fill_component(comp, cube_min, x_, fill_);
+      if (binary_)
+        fill_component_binary(comp, cube_min, x_, fill_);
+      else
+        fill_component(comp, cube_min, x_, fill_);
       stats_.fallback_cubes += fill_.used_fallback;
       stats_.unresolved_cubes += !fill_.resolved;
       for (std::size_t n = 0; n < fill_.privates.size(); ++n)
         ids[kPrivatePoint0 + n] = add_node(fill_.privates[n]);
-      for (const auto& t : fill_.tets)
+      for (const auto& t : fill_.tets) {
         mesh_.tets.push_back({ids[t[0]], ids[t[1]], ids[t[2]], ids[t[3]]});
-      for (const auto& p : fill_.pyramids)
+        unite(mesh_.tets.back());
+      }
+      for (const auto& p : fill_.pyramids) {
         mesh_.pyramids.push_back({ids[p[0]], ids[p[1]], ids[p[2]], ids[p[3]], ids[p[4]]});
+        unite(mesh_.pyramids.back());
+      }
       for (const auto& t : fill_.iso_triangles) {
         mesh_.boundary_tris.push_back({ids[t[0]], ids[t[1]], ids[t[2]]});
         mesh_.boundary_tri_patch.push_back(wall_);
@@ -357,26 +382,23 @@ class Mesher {
   int wall_ = 0;
   int side_[6];
   std::array<Eigen::Vector3d, kMaxLocalPoints> x_;  // local point positions of the cube
+  bool binary_ = false;
+  bool track_components_ = false;
+  BigVector<NodeId> parent_;
   ComponentFill fill_;
 };
 
-// Keeps the connected component (through shared nodes) with the most cells.
-void keep_largest_component(HybridMesh& mesh, MveStats& stats) {
-  std::vector<NodeId> parent(mesh.nodes.size());
-  std::iota(parent.begin(), parent.end(), 0);
+// Keeps the connected component (through shared nodes) with the most cells, given the
+// union-find forest the mesher built.
+void keep_largest_component(HybridMesh& mesh, BigVector<NodeId>& parent, MveStats& stats) {
   auto find = [&](NodeId a) {
     while (parent[a] != a) a = parent[a] = parent[parent[a]];
     return a;
   };
-  auto unite_cells = [&](const auto& cells) {
-    for (const auto& c : cells) {
-      const NodeId r = find(c[0]);
-      for (NodeId n : c) parent[find(n)] = r;
-    }
-  };
-  unite_cells(mesh.tets);
-  unite_cells(mesh.pyramids);
-  unite_cells(mesh.hexes);
+  std::size_t roots = 0;
+  for (std::size_t n = 0; n < parent.size(); ++n) roots += parent[n] == static_cast<NodeId>(n);
+  stats.components = roots;
+  if (roots <= 1) return;  // the common case: nothing to drop, no further pass
   std::vector<std::uint32_t> cells_of(mesh.nodes.size(), 0);
   auto count = [&](const auto& cells) {
     for (const auto& c : cells) ++cells_of[find(c[0])];
@@ -396,7 +418,9 @@ void keep_largest_component(HybridMesh& mesh, MveStats& stats) {
   stats.dropped_components = components - 1;
   auto keep = [&](auto& cells) {
     const auto before = cells.size();
-    std::erase_if(cells, [&](const auto& c) { return find(c[0]) != largest; });
+    cells.erase(std::remove_if(cells.begin(), cells.end(),
+                               [&](const auto& c) { return find(c[0]) != largest; }),
+                cells.end());
     stats.dropped_cells += before - cells.size();
   };
   keep(mesh.tets);
@@ -427,7 +451,7 @@ HybridMesh march_volume_elements(const FieldSource& field, const MveOptions& opt
   mesher.run();
   if (mesh.cell_count() == 0)
     fail("nothing is inside: no voxel passes the threshold or label in the meshed region");
-  if (options.keep_largest_component) keep_largest_component(mesh, stats);
+  if (options.keep_largest_component) keep_largest_component(mesh, mesher.parents(), stats);
   // Nodes are made only when a cell needs them: unused ones exist only after dropping.
   if (stats.dropped_components) compact_nodes(mesh);
   remove_empty_patches(mesh);

@@ -21,6 +21,8 @@ class FieldSource {
   virtual ~FieldSource() = default;
   virtual const ImageFrame& frame() const = 0;
   virtual void read_slice(int k, std::span<float> out) const = 0;
+  // True when every value is +1 or -1 (a labelmap): every isopoint is then an edge midpoint.
+  virtual bool binary() const { return false; }
 };
 
 // The box of voxels to mesh (inclusive index bounds). Cube faces on its sides close the object
@@ -75,6 +77,7 @@ class VolumeField : public FieldSource {
   VolumeField(const Volume<float>& volume, Mode mode, double level);
   const ImageFrame& frame() const override { return volume_.frame; }
   void read_slice(int k, std::span<float> out) const override;
+  bool binary() const override { return mode_ == Mode::label; }
 
  private:
   const Volume<float>& volume_;

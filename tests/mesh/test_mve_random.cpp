@@ -1,6 +1,8 @@
 // Random scalar fields, from white noise to smooth blobs, on grids up to 64³.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <numeric>
 #include <random>
 
 #include "core/error.h"
@@ -76,6 +78,58 @@ TEST(MveRandom, LargeFieldsUpTo64Cubed) {
   check_random(1001, {64, 64, 64}, 0);
   check_random(1002, {64, 64, 64}, 1);
   check_random(1003, {64, 48, 40}, 2);
+}
+
+// Components counted from every cell's nodes, independently of the mesher's bookkeeping.
+std::size_t count_components(const HybridMesh& m) {
+  std::vector<NodeId> parent(m.nodes.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](NodeId a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  auto unite = [&](const auto& cells) {
+    for (const auto& c : cells)
+      for (NodeId n : c) parent[find(n)] = find(c[0]);
+  };
+  unite(m.tets);
+  unite(m.pyramids);
+  unite(m.hexes);
+  std::vector<char> used(m.nodes.size(), 0);
+  auto mark = [&](const auto& cells) {
+    for (const auto& c : cells) used[find(c[0])] = 1;
+  };
+  mark(m.tets);
+  mark(m.pyramids);
+  mark(m.hexes);
+  return static_cast<std::size_t>(std::count(used.begin(), used.end(), 1));
+}
+
+TEST(MveRandom, ComponentCountMatchesAnIndependentCount) {
+  int multi = 0, with_hexes = 0;
+  for (std::uint32_t seed = 1; seed <= 40; ++seed) {
+    std::mt19937 rng(seed);
+    const ArrayField field = random_field(rng, {24, 20, 18}, 2);
+    mve::MveOptions all = testing::quiet_options();
+    HybridMesh everything;
+    try {
+      everything = mve::march_volume_elements(field, all);
+    } catch (const Error&) {
+      continue;
+    }
+    mve::MveOptions largest = all;
+    largest.keep_largest_component = true;
+    mve::MveStats stats;
+    const HybridMesh kept = mve::march_volume_elements(field, largest, &stats);
+    EXPECT_EQ(stats.components, count_components(everything)) << "seed " << seed;
+    multi += stats.components > 1;
+    with_hexes += everything.hexes.size() > 100;
+    EXPECT_EQ(count_components(kept), 1u) << "seed " << seed;
+    EXPECT_EQ(kept.cell_count() + stats.dropped_cells, everything.cell_count()) << "seed " << seed;
+  }
+  // The fields must exercise what is tested: several components, interior hexahedra.
+  EXPECT_GT(multi, 10);
+  EXPECT_GT(with_hexes, 10);
 }
 
 TEST(MveRandom, KeepsTheLargestComponentOnly) {

@@ -92,7 +92,8 @@ TEST(Patches, IndexPlaneCropsTheSideAwayFromTheObject) {
   // The ball's centre is at k ≈ 11.4: the plane k = 11 keeps the upper half.
   const HybridMesh m = mesh_with_cuts(f, {{"inlet", parse_cut_plane("k=11")}});
   EXPECT_TRUE(check_mesh(m).valid());
-  const auto& inlet = find(patch_report(m), "inlet");
+  const auto report = patch_report(m);
+  const auto& inlet = find(report, "inlet");
   const double expected = std::numbers::pi * (81.0 - 0.4 * 0.4);
   EXPECT_NEAR(inlet.area, expected, 0.02 * expected);
   for (const auto& x : m.nodes) EXPECT_GE(x[2], 11.0 - 1e-12);

@@ -6,7 +6,6 @@
 #include <vtkPointData.h>
 #include <vtkSmartPointer.h>
 #include <vtkXMLImageDataWriter.h>
-
 #include <zlib.h>
 
 #include <filesystem>
