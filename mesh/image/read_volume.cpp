@@ -1,9 +1,12 @@
 #include "image/read_volume.h"
 
+#include <gdcmDirectory.h>
+#include <gdcmIPPSorter.h>
+#include <gdcmTrace.h>
 #include <vtkCallbackCommand.h>
-#include <vtkDICOMImageReader.h>
 #include <vtkDataArray.h>
 #include <vtkExecutive.h>
+#include <vtkGDCMImageReader.h>
 #include <vtkImageData.h>
 #include <vtkImageReader2.h>
 #include <vtkMatrix3x3.h>
@@ -13,6 +16,7 @@
 #include <vtkNrrdReader.h>
 #include <vtkPointData.h>
 #include <vtkSmartPointer.h>
+#include <vtkStringArray.h>
 #include <vtkXMLImageDataReader.h>
 #include <zlib.h>
 
@@ -203,10 +207,51 @@ Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
     reader->SetFileName(path.c_str());
     run(reader);
   } else if (ext == "<dir>") {
+    // A DICOM series: GDCM orders the files by their position along the slice normal and
+    // measures the spacing between them; the frame comes from the first slice's Image Position
+    // and the Image Orientation, with rows kept in file order.
     meta.format = "dicom";
-    auto reader = vtkSmartPointer<vtkDICOMImageReader>::New();
-    reader->SetDirectoryName(path.c_str());
+    gdcm::Trace::SetWarning(false);
+    gdcm::Trace::SetDebug(false);
+    gdcm::Trace::SetError(false);
+    gdcm::Directory folder;
+    folder.Load(path.string(), false);
+    const std::vector<std::string> files = folder.GetFilenames();
+    if (files.empty()) fail("{}: the folder holds no files", path.string());
+    if (files.size() < 2)
+      fail("{}: the series has a single slice; a volume needs at least two", path.string());
+    gdcm::IPPSorter sorter;
+    sorter.SetComputeZSpacing(true);
+    sorter.SetZSpacingTolerance(1e-3);
+    if (!sorter.Sort(files))
+      fail(
+          "{}: cannot order the slices by position (files that are not DICOM, missing Image "
+          "Position/Orientation, or slices of different orientation)",
+          path.string());
+    const double dz = sorter.GetZSpacing();
+    if (!(dz > 0.0))
+      fail(
+          "{}: the slices are not evenly spaced; resample the series to a uniform spacing "
+          "before meshing",
+          path.string());
+    auto names = vtkSmartPointer<vtkStringArray>::New();
+    for (const auto& f : sorter.GetFilenames()) names->InsertNextValue(f);
+    auto reader = vtkSmartPointer<vtkGDCMImageReader>::New();
+    reader->SetFileNames(names);
+    reader->FileLowerLeftOn();
     run(reader);
+    if (errors.message.empty() && image) {
+      const double* iop = reader->GetImageOrientationPatient();
+      const Eigen::Vector3d row(iop[0], iop[1], iop[2]), col(iop[3], iop[4], iop[5]);
+      frame.direction.col(0) = row.normalized();
+      frame.direction.col(1) = col.normalized();
+      frame.direction.col(2) = row.cross(col).normalized();
+      const double* ipp = reader->GetImagePositionPatient();
+      frame.origin = Eigen::Vector3d(ipp[0], ipp[1], ipp[2]);
+      const double* sp = image->GetSpacing();
+      frame.spacing = Eigen::Vector3d(sp[0], sp[1], dz);
+      frame_from_header = true;
+    }
   } else {
     fail(
         "{}: unknown image format '{}' (expected .nrrd, .nhdr, .nii, .nii.gz, .mha, .mhd, "

@@ -8,10 +8,12 @@
 #include <vtkXMLImageDataWriter.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
 #include "core/error.h"
+#include "dicom_writer.h"
 #include "image/read_volume.h"
 
 namespace naris {
@@ -85,6 +87,34 @@ TEST(ReadVolume, MetaImageRoundTrip) {
 }
 TEST(ReadVolume, VtiRoundTrip) {
   round_trip<vtkXMLImageDataWriter>("naris-sample.vti");
+}
+
+TEST(ReadVolume, DicomSeriesFolder) {
+  const int nx = 6, ny = 5;
+  std::vector<std::vector<std::int16_t>> slices(4, std::vector<std::int16_t>(nx * ny));
+  for (int k = 0; k < 4; ++k)
+    for (int n = 0; n < nx * ny; ++n)
+      slices[k][n] =
+          static_cast<std::int16_t>(24 + 37 * n + 300 * k);  // stored; HU = stored − 1024
+  const fs::path dir = fs::temp_directory_path() / "naris-dicom-series";
+  fs::remove_all(dir);
+  // Files named so that a name order would be wrong: the positions decide.
+  testing::write_dicom_series(dir, nx, ny, slices, 0.4, 0.5, {14.0, 5.0, 11.0, 8.0});
+  VolumeInfo info;
+  const Volume<float> v = read_volume(dir, &info);
+  EXPECT_EQ(info.format, "dicom");
+  ASSERT_EQ(v.dims(), (std::array<int, 3>{nx, ny, 4}));
+  EXPECT_NEAR(v.frame.spacing[0], 0.4, 1e-6);  // column spacing (along a row)
+  EXPECT_NEAR(v.frame.spacing[1], 0.5, 1e-6);  // row spacing
+  EXPECT_NEAR(v.frame.spacing[2], 3.0, 1e-6);
+  EXPECT_NEAR((v.frame.origin - Eigen::Vector3d(-10, -20, 5)).norm(), 0.0, 1e-6);
+  EXPECT_NEAR((v.frame.direction - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-9);
+  // Slice k of the volume is the file at z = 5 + 3k, rows in file order, values in HU.
+  const int file_of[4] = {1, 3, 2, 0};
+  for (int k = 0; k < 4; ++k)
+    for (int n = 0; n < nx * ny; ++n)
+      ASSERT_EQ(v.slice(k)[n], slices[file_of[k]][n] - 1024.0f) << "slice " << k << " voxel " << n;
+  fs::remove_all(dir);
 }
 
 TEST(ReadVolume, MissingFileIsAClearError) {
