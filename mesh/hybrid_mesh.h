@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,26 @@ struct HybridMesh {
   int patch_id(const std::string& name) const;  // -1 when absent
   int add_patch(const std::string& name);       // returns the existing id if present
 };
+
+// Calls f(nodes, patch) for every boundary face, triangles then quadrilaterals; `nodes` is a
+// std::span over the face's node ids and `patch` its patch id (assignable).
+template <class F>
+void for_each_boundary_face(HybridMesh& m, F&& f) {
+  for (std::size_t i = 0; i < m.boundary_tris.size(); ++i)
+    f(std::span<NodeId>(m.boundary_tris[i]), m.boundary_tri_patch[i]);
+  for (std::size_t i = 0; i < m.boundary_quads.size(); ++i)
+    f(std::span<NodeId>(m.boundary_quads[i]), m.boundary_quad_patch[i]);
+}
+template <class F>
+void for_each_boundary_face(const HybridMesh& m, F&& f) {
+  for (std::size_t i = 0; i < m.boundary_tris.size(); ++i)
+    f(std::span<const NodeId>(m.boundary_tris[i]), m.boundary_tri_patch[i]);
+  for (std::size_t i = 0; i < m.boundary_quads.size(); ++i)
+    f(std::span<const NodeId>(m.boundary_quads[i]), m.boundary_quad_patch[i]);
+}
+
+// Area of a planar (or nearly planar) polygon: half the norm of its vector area.
+double polygon_area(const HybridMesh& m, std::span<const NodeId> nodes);
 
 // Signed volumes; positive for valid cells in VTK order.
 double tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,

@@ -164,16 +164,11 @@ void finish_patches(HybridMesh& mesh, const mve::FieldSource& field, const std::
   const double tolerance = 1e-6 * field.frame().spacing.minCoeff();
   for (const Cut& cut : prepared.oblique) {
     const int id = mesh.add_patch(cut.patch);
-    auto on_plane = [&](const auto& face) {
+    for_each_boundary_face(mesh, [&](std::span<NodeId> face, std::int32_t& patch) {
       for (NodeId n : face)
-        if (std::abs(cut.plane.normal.dot(mesh.nodes[n] - cut.plane.point)) > tolerance)
-          return false;
-      return true;
-    };
-    for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f)
-      if (on_plane(mesh.boundary_tris[f])) mesh.boundary_tri_patch[f] = id;
-    for (std::size_t f = 0; f < mesh.boundary_quads.size(); ++f)
-      if (on_plane(mesh.boundary_quads[f])) mesh.boundary_quad_patch[f] = id;
+        if (std::abs(cut.plane.normal.dot(mesh.nodes[n] - cut.plane.point)) > tolerance) return;
+      patch = id;
+    });
   }
   const auto report = patch_report(mesh);
   for (const Cut& cut : cuts) {
@@ -191,18 +186,13 @@ void finish_patches(HybridMesh& mesh, const mve::FieldSource& field, const std::
   const int from = mesh.patch_id(from_patch);
   for (const Region& region : regions) {
     const int id = mesh.add_patch(region.name);
-    auto centroid = [&](const auto& face) {
+    std::size_t moved = 0;
+    for_each_boundary_face(mesh, [&](std::span<NodeId> face, std::int32_t& patch) {
+      if (patch != from) return;
       Eigen::Vector3d c = Eigen::Vector3d::Zero();
       for (NodeId n : face) c += mesh.nodes[n];
-      return Eigen::Vector3d(c / static_cast<double>(face.size()));
-    };
-    std::size_t moved = 0;
-    for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f)
-      if (mesh.boundary_tri_patch[f] == from && region.contains(centroid(mesh.boundary_tris[f])))
-        mesh.boundary_tri_patch[f] = id, ++moved;
-    for (std::size_t f = 0; f < mesh.boundary_quads.size(); ++f)
-      if (mesh.boundary_quad_patch[f] == from && region.contains(centroid(mesh.boundary_quads[f])))
-        mesh.boundary_quad_patch[f] = id, ++moved;
+      if (region.contains(c / static_cast<double>(face.size()))) patch = id, ++moved;
+    });
     if (moved == 0)
       fail("region '{}' contains no {} face: check its coordinates (millimetres, image frame)",
            region.name, from_patch);
@@ -213,29 +203,14 @@ std::vector<PatchReport> patch_report(const HybridMesh& mesh) {
   std::vector<PatchReport> report(mesh.patch_names.size());
   std::vector<std::map<std::pair<NodeId, NodeId>, int>> edges(mesh.patch_names.size());
   for (std::size_t p = 0; p < report.size(); ++p) report[p].name = mesh.patch_names[p];
-  auto add_face = [&](const auto& face, int patch, double area) {
+  for_each_boundary_face(mesh, [&](std::span<const NodeId> face, std::int32_t patch) {
     report[patch].faces++;
-    report[patch].area += area;
-    const std::size_t n = face.size();
-    for (std::size_t e = 0; e < n; ++e) {
-      const NodeId a = face[e], b = face[(e + 1) % n];
+    report[patch].area += polygon_area(mesh, face);
+    for (std::size_t e = 0; e < face.size(); ++e) {
+      const NodeId a = face[e], b = face[(e + 1) % face.size()];
       edges[patch][{std::min(a, b), std::max(a, b)}]++;
     }
-  };
-  for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f) {
-    const auto& t = mesh.boundary_tris[f];
-    const double area =
-        0.5 *
-        (mesh.nodes[t[1]] - mesh.nodes[t[0]]).cross(mesh.nodes[t[2]] - mesh.nodes[t[0]]).norm();
-    add_face(t, mesh.boundary_tri_patch[f], area);
-  }
-  for (std::size_t f = 0; f < mesh.boundary_quads.size(); ++f) {
-    const auto& q = mesh.boundary_quads[f];
-    const double area =
-        0.5 *
-        (mesh.nodes[q[2]] - mesh.nodes[q[0]]).cross(mesh.nodes[q[3]] - mesh.nodes[q[1]]).norm();
-    add_face(q, mesh.boundary_quad_patch[f], area);
-  }
+  });
   // A patch's perimeter: the edges that only one of its own faces uses.
   for (std::size_t p = 0; p < report.size(); ++p)
     for (const auto& [e, count] : edges[p])

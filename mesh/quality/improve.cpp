@@ -99,41 +99,33 @@ Vec face_normal(const Face& f, const std::vector<Vec>& x) {
   return (x[f.v[2]] - x[f.v[0]]).cross(x[f.v[3]] - x[f.v[1]]);
 }
 
-// The cell after collapsing b into a (a survives); size 0 if it degenerates away.
-Cell collapsed(const Cell& c, NodeId a, NodeId b) {
-  Cell out = c;
-  if (!has(c, b)) return out;
-  if (!has(c, a)) {
-    std::replace(out.v.begin(), out.v.begin() + c.size, b, a);
+// A cell or boundary face after collapsing b into a (a survives). Where only b is present it
+// is renamed; where both are, a simplex (tetrahedron, triangle) degenerates away (size 0),
+// while a pyramid or a quadrilateral drops b from its base: the pyramid becomes a tetrahedron
+// (base order kept, apex last), the quadrilateral a triangle.
+template <class Item>
+Item collapsed(const Item& item, NodeId a, NodeId b, int simplex) {
+  Item out = item;
+  if (!has(item, b)) return out;
+  if (!has(item, a)) {
+    std::replace(out.v.begin(), out.v.begin() + item.size, b, a);
     return out;
   }
-  if (c.size == 4) return Cell{};
-  // Pyramid with base edge (a, b): the base triangle that remains, in base order, and the apex.
-  std::array<NodeId, 3> base;
-  int k = 0;
-  for (int i = 0; i < 4; ++i)
-    if (c.v[i] != b) base[k++] = c.v[i];
-  out.size = 4;
-  out.v = {base[0], base[1], base[2], c.v[4], 0, 0, 0, 0};
-  return out;
-}
-
-Face collapsed(const Face& f, NodeId a, NodeId b) {
-  Face out = f;
-  if (!has(f, b)) return out;
-  if (!has(f, a)) {
-    std::replace(out.v.begin(), out.v.begin() + f.size, b, a);
-    return out;
-  }
-  if (f.size == 3) {
+  if (item.size == simplex) {
     out.size = 0;
     return out;
   }
   int k = 0;
-  for (int i = 0; i < 4; ++i)
-    if (f.v[i] != b) out.v[k++] = f.v[i];
-  out.size = 3;
+  for (int i = 0; i < item.size; ++i)
+    if (item.v[i] != b) out.v[k++] = item.v[i];
+  out.size = static_cast<std::uint8_t>(item.size - 1);
   return out;
+}
+Cell collapsed(const Cell& c, NodeId a, NodeId b) {
+  return collapsed(c, a, b, 4);
+}
+Face collapsed(const Face& f, NodeId a, NodeId b) {
+  return collapsed(f, a, b, 3);
 }
 
 }  // namespace

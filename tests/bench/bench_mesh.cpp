@@ -37,21 +37,6 @@ void reset_peak_memory() {
   std::ofstream("/proc/self/clear_refs") << "5";
 }
 
-std::size_t current_memory_bytes() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmRSS:") {
-      std::size_t kib = 0;
-      status >> kib;
-      return kib * 1024;
-    }
-    std::string rest;
-    std::getline(status, rest);
-  }
-  return 0;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -103,12 +88,10 @@ int main(int argc, char** argv) {
     const mve::VolumeField field(labels, mve::VolumeField::Mode::label, 1.0);
 
     reset_peak_memory();
-    const std::size_t before = current_memory_bytes();
     Stopwatch clock;
     HybridMesh mesh = mve::march_volume_elements(field, mve::MveOptions{});
     const double mve_seconds = clock.seconds();
     const double peak_mb = static_cast<double>(peak_memory_bytes()) / 1e6;
-    (void)before;
 
     // VTK's discrete flying edges on the same labels (surface only).
     auto image = vtkSmartPointer<vtkImageData>::New();
