@@ -32,6 +32,7 @@ std::vector<Vec> local_points(const CaseEntry& e, const std::array<double, 12>& 
 
 struct Filled {
   bool valid = true;
+  bool closed = true;            // every edge of the cube's boundary polygons is used exactly twice
   double cell_volume = 0.0;      // sum of cell volumes
   double boundary_volume = 0.0;  // enclosed by face polygons + isosurface triangles
 };
@@ -41,10 +42,15 @@ Filled fill(const CaseEntry& e, const std::array<double, 12>& t) {
   Filled r;
   const auto base = local_points(e, t);
   auto enclosed = [](const Vec& a, const Vec& b, const Vec& c) { return a.dot(b.cross(c)) / 6.0; };
+  std::map<std::pair<int, int>, int> boundary_edges;
   for (int f = 0; f < 6; ++f)
-    for (const auto& p : e.face_polygons[f])
+    for (const auto& p : e.face_polygons[f]) {
       for (int i = 1; i + 1 < p.size; ++i)
         r.boundary_volume += enclosed(base[p.p[0]], base[p.p[i]], base[p.p[i + 1]]);
+      for (int k = 0; k < p.size; ++k)
+        ++boundary_edges[{std::min(p.p[k], p.p[(k + 1) % p.size]),
+                          std::max(p.p[k], p.p[(k + 1) % p.size])}];
+    }
   for (const auto& comp : e.components) {
     std::array<Vec, kMaxLocalPoints> x;
     std::copy(base.begin(), base.end(), x.begin());
@@ -67,9 +73,20 @@ Filled fill(const CaseEntry& e, const std::array<double, 12>& t) {
                 tet(c[1], c[2], c[3], c[4]) > 0.0;
       r.cell_volume += v1 + v2;
     }
-    for (const auto& tri : out.iso_triangles)
+    // Private point ids restart in every component: edges that touch one are counted per
+    // component, edges between cube points over the whole cube.
+    std::map<std::pair<int, int>, int> private_edges;
+    for (const auto& tri : out.iso_triangles) {
       r.boundary_volume += enclosed(pts[tri[0]], pts[tri[1]], pts[tri[2]]);
+      for (int k = 0; k < 3; ++k) {
+        const std::pair<int, int> edge{std::min(tri[k], tri[(k + 1) % 3]),
+                                       std::max(tri[k], tri[(k + 1) % 3])};
+        ++(edge.second >= kPrivatePoint0 ? private_edges : boundary_edges)[edge];
+      }
+    }
+    for (const auto& [edge, n] : private_edges) r.closed = r.closed && n == 2;
   }
+  for (const auto& [edge, n] : boundary_edges) r.closed = r.closed && n == 2;
   return r;
 }
 
@@ -119,6 +136,7 @@ TEST(CaseTable, EveryEntryFillsItsRegionAtMidpointIsopoints) {
   for_each_entry([&](std::uint8_t config, std::uint8_t mask) {
     const Filled r = fill(case_entry(config, mask), mid);
     ASSERT_TRUE(r.valid) << "config " << int(config) << " mask " << int(mask);
+    ASSERT_TRUE(r.closed) << "config " << int(config) << " mask " << int(mask);
     ASSERT_NEAR(r.cell_volume, r.boundary_volume, 1e-12) << "config " << int(config);
   });
 }
@@ -164,7 +182,8 @@ TEST(CaseTable, EveryConfigurationFillsItsRegionForRandomVertexValues) {
                       << ::testing::PrintToString(t);
         continue;
       }
-      // Cells exactly fill the region the face polygons and the isosurface enclose.
+      // Cells exactly fill the closed region the face polygons and the isosurface enclose.
+      ASSERT_TRUE(r.closed) << "config " << config << " mask " << int(mask);
       ASSERT_NEAR(r.cell_volume, r.boundary_volume, 1e-9) << "config " << config;
     }
     const auto amb = ambiguous_faces(static_cast<std::uint8_t>(config));
