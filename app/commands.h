@@ -4,5 +4,6 @@
 namespace naris::app {
 
 void add_mesh_command(CLI::App& app);
+void add_eog_command(CLI::App& app);
 
 }  // namespace naris::app

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   app.parse_complete_callback(
       [&] { naris::set_verbosity(quiet ? naris::Verbosity::quiet : naris::Verbosity::normal); });
   naris::app::add_mesh_command(app);
+  naris::app::add_eog_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -192,6 +192,14 @@ OrderSearchResult search_orders(const std::vector<double>& u_fit, const std::vec
     for (int nb = 1; nb <= std::min(na, o.max_nb); ++nb)
       for (int nd = o.min_nd; nd <= o.max_nd; ++nd) jobs.push_back({na, nb, nd});
   if (jobs.empty()) fail("no model orders to search (check the order ranges)");
+  if (u_fit.size() != y_fit.size() || u_val.size() != y_val.size())
+    fail("stimulus and response records differ in length");
+  const auto needed = static_cast<std::size_t>(2 * 2 + o.min_nd + 1);
+  if (y_fit.size() <= needed || y_val.size() <= needed)
+    fail(
+        "the records ({} and {} samples after preprocessing) are too short for the orders "
+        "searched (nd from {})",
+        y_fit.size(), y_val.size(), o.min_nd);
 
   OrderSearchResult result;
   result.tried.resize(jobs.size());

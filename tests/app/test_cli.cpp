@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
+#include <regex>
 #include <sstream>
 #include <vector>
 
@@ -174,6 +176,99 @@ TEST_F(Cli, UnknownOptionIsAnError) {
   const CliRun r = naris("mesh --frobnicate");
   EXPECT_NE(r.status, 0);
   EXPECT_EQ(r.err.rfind("naris: error: ", 0), 0u) << r.err;
+}
+
+}  // namespace
+
+namespace {
+
+class CliEog : public Cli {
+ protected:
+  // A two-column recording at 1 kHz of the rat single-cell model's response to 16 mM, 500 ms.
+  fs::path recording(const std::string& name, unsigned seed) {
+    const CliRun r = naris(
+        "eog simulate --model rat-single-cell --pulse 16mM,500ms --onset 0.5 "
+        "--length 6 -o " +
+        (dir_ / "in" / "sim").string());
+    EXPECT_EQ(r.status, 0) << r.err;
+    std::ifstream in(dir_ / "in" / "sim.csv");
+    std::string header, line;
+    std::getline(in, header);
+    std::vector<double> y;
+    while (std::getline(in, line)) y.push_back(std::stod(line.substr(line.rfind(',') + 1)));
+    const fs::path p = dir_ / "in" / name;
+    std::ofstream out(p);
+    out << "Time (s)\tTrace (pA)\n";
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, 2.0);
+    for (int k = 0; k < 6000; ++k) {
+      const double t = k / 1000.0, pos = t * 200.0;
+      const auto i = std::min<std::size_t>(static_cast<std::size_t>(pos), y.size() - 2);
+      const double w = pos - static_cast<double>(i);
+      out << t << "\t" << (1 - w) * y[i] + w * y[i + 1] + noise(rng) << "\n";
+    }
+    return p;
+  }
+};
+
+TEST_F(CliEog, SimulateWritesCsvAndPng) {
+  const CliRun r = naris("eog simulate --model rat-single-cell --pulse 16mM,500ms -o " +
+                         (dir_ / "out" / "resp").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "resp.csv"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "resp.png"));
+  EXPECT_NE(r.err.find("latency 0.260 s"), std::string::npos) << r.err;  // n_d = 52 at 200 Hz
+}
+
+TEST_F(CliEog, UnstablePresetIsRefusedUnlessStabilizedOrForced) {
+  expect_clean_failure(naris("eog simulate --model dog-eog -o " + (dir_ / "out" / "r").string()),
+                       "|z| = 1.01");
+  EXPECT_EQ(
+      naris("eog simulate --model dog-eog --stabilize -o " + (dir_ / "s" / "r").string()).status,
+      0);
+  EXPECT_EQ(
+      naris("eog simulate --model dog-eog --force --length 2 -o " + (dir_ / "f" / "r").string())
+          .status,
+      0);
+}
+
+TEST_F(CliEog, FitRecoversAModelThatReproducesTheValidationRecord) {
+  const fs::path fit = recording("fit.txt", 1), val = recording("val.txt", 2);
+  const CliRun r = naris("eog fit --fit " + fit.string() + " --validation " + val.string() +
+                         " --pulse 16mM,500ms --onset 0.5 --max-na 6 --max-nb 2 --min-nd 48 "
+                         "--max-nd 56 -o " +
+                         (dir_ / "out" / "model.yaml").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "model.png"));
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, std::regex(R"(([0-9.]+) % on the validation record)")))
+      << r.err;
+  const double percent = std::stod(m[1].str());
+  EXPECT_GT(percent, 95.0) << r.err;
+  // The fitted model simulates and predicts.
+  const CliRun s = naris("eog predict --model " + (dir_ / "out" / "model.yaml").string() +
+                         " --stimulus " + fit.string() + " -o " + (dir_ / "out" / "pred").string());
+  EXPECT_EQ(s.status, 0) << s.err;
+}
+
+TEST_F(CliEog, BadRecordingsAreClearErrors) {
+  std::ofstream(dir_ / "in" / "empty.txt") << "";
+  std::ofstream(dir_ / "in" / "words.txt") << "time value\n0 1\n0.001 one\n";
+  std::ofstream(dir_ / "in" / "back.txt") << "0 1\n0.002 1\n0.001 1\n0.003 1\n";
+  std::ofstream(dir_ / "in" / "short.txt") << "0 1\n0.005 2\n0.010 3\n0.015 4\n";
+  const std::string common =
+      " --pulse 16mM,200ms --onset 0 -o " + (dir_ / "out" / "m.yaml").string();
+  auto fit = [&](const std::string& f) {
+    const std::string p = (dir_ / "in" / f).string();
+    return naris("eog fit --fit " + p + " --validation " + p + common);
+  };
+  expect_clean_failure(fit("empty.txt"), "no data");
+  expect_clean_failure(fit("words.txt"), "not two numbers");
+  expect_clean_failure(fit("back.txt"), "decreases");
+  expect_clean_failure(fit("short.txt"), "too short");
+  expect_clean_failure(naris("eog simulate --model rat-single-cell --pulse 16,200 -o " +
+                             (dir_ / "out" / "x").string()),
+                       "not understood");
 }
 
 }  // namespace
