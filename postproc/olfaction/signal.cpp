@@ -5,6 +5,7 @@
 #include <cmath>
 #include <complex>
 #include <fstream>
+#include <random>
 #include <regex>
 #include <sstream>
 
@@ -128,6 +129,20 @@ std::vector<double> pulse_samples(const Pulse& p, double onset, double length, d
   const auto first = static_cast<std::size_t>(std::llround(onset * rate));
   const auto count = static_cast<std::size_t>(std::llround(p.duration * rate));
   for (std::size_t k = first; k < std::min(n, first + count); ++k) u[k] = amplitude;
+  return u;
+}
+
+std::vector<double> random_pulse_train(unsigned seed, std::size_t samples, double amplitude,
+                                       int hold) {
+  if (hold < 1) fail("pulse train: the hold must be at least one sample");
+  std::mt19937 rng(seed);
+  std::bernoulli_distribution on(0.5);
+  std::vector<double> u(samples);
+  double v = 0.0;
+  for (std::size_t k = 0; k < samples; ++k) {
+    if (k % static_cast<std::size_t>(hold) == 0) v = on(rng) ? amplitude : 0.0;
+    u[k] = v;
+  }
   return u;
 }
 

@@ -32,6 +32,11 @@ Pulse parse_pulse(const std::string& text);
 std::vector<double> pulse_samples(const Pulse& p, double onset, double length, double rate,
                                   const std::string& unit);
 
+// A train of pulses of random timing: every `hold` samples the stimulus is switched on (at
+// `amplitude`) or off with equal odds. Persistently exciting, unlike a single pulse.
+std::vector<double> random_pulse_train(unsigned seed, std::size_t samples, double amplitude,
+                                       int hold);
+
 // Zero-phase low-pass: a 4th-order Bessel filter (−3 dB at the cutoff), run forwards and
 // backwards, so the delay cancels and the attenuation at the cutoff is −6 dB.
 std::vector<double> bessel_lowpass(const std::vector<double>& x, double cutoff_hz, double rate_hz);

@@ -17,18 +17,6 @@ using namespace naris::olfaction;
 
 namespace {
 
-std::vector<double> pulse_train(unsigned seed, std::size_t n, double amplitude, int hold) {
-  std::mt19937 rng(seed);
-  std::bernoulli_distribution on(0.5);
-  std::vector<double> u(n);
-  double v = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    if (k % static_cast<std::size_t>(hold) == 0) v = on(rng) ? amplitude : 0.0;
-    u[k] = v;
-  }
-  return u;
-}
-
 std::vector<double> with_noise(std::vector<double> y, double snr_db, unsigned seed) {
   double power = 0.0;
   for (double v : y) power += v * v;
@@ -61,7 +49,7 @@ int main() {
                         {"random pulse train", true, 40, 2}};
   for (const Case& c : cases) {
     const auto make_u = [&](unsigned seed) {
-      return c.train ? pulse_train(seed, 2000, 16.0, 4)
+      return c.train ? random_pulse_train(seed, 2000, 16.0, 4)
                      : pulse_samples(parse_pulse("16mM,500ms"), 0.5, 10.0, 200.0, "mM");
     };
     const auto u_fit = make_u(1), u_val = make_u(2);

@@ -188,22 +188,9 @@ TEST_F(Records, BadFilesAreClearErrors) {
   EXPECT_THROW(read_record(fs::temp_directory_path() / "naris-eog-absent.txt"), Error);
 }
 
-// A train of odorant pulses of random timing (persistently exciting, unlike one pulse).
-std::vector<double> pulse_train(unsigned seed, std::size_t n, double amplitude, int hold) {
-  std::mt19937 rng(seed);
-  std::bernoulli_distribution on(0.5);
-  std::vector<double> u(n);
-  double v = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    if (k % static_cast<std::size_t>(hold) == 0) v = on(rng) ? amplitude : 0.0;
-    u[k] = v;
-  }
-  return u;
-}
-
 TEST(Identify, RecoversAModelExactlyFromNoiseFreeData) {
   const OeModel truth = rat_single_cell();
-  const auto u = pulse_train(1, 2000, 16.0, 4);
+  const auto u = random_pulse_train(1, 2000, 16.0, 4);
   const OeModel fit = fit_oe(u, simulate(truth, u), 5, 1, 52);
   for (int j = 0; j < 5; ++j) EXPECT_NEAR(fit.a[j], truth.a[j], 1e-6);
   EXPECT_NEAR(fit.b[0], truth.b[0], 1e-6);
@@ -214,7 +201,8 @@ TEST(Identify, RecoversAModelExactlyFromNoiseFreeData) {
 // noisy record no model can exceed ≈ 82 % at this SNR.)
 TEST(Identify, OrderSearchAt20dBReproducesTheResponse) {
   const OeModel truth = rat_single_cell();
-  const auto u_fit = pulse_train(1, 2000, 16.0, 4), u_val = pulse_train(2, 2000, 16.0, 4);
+  const auto u_fit = random_pulse_train(1, 2000, 16.0, 4),
+             u_val = random_pulse_train(2, 2000, 16.0, 4);
   const auto clean_fit = simulate(truth, u_fit), clean_val = simulate(truth, u_val);
   auto noisy = [](std::vector<double> y, unsigned seed) {
     double power = 0;
