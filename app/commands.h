@@ -5,5 +5,6 @@ namespace naris::app {
 
 void add_mesh_command(CLI::App& app);
 void add_eog_command(CLI::App& app);
+void add_segment_command(CLI::App& app);
 
 }  // namespace naris::app

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "print nothing but errors")->configurable(false);
   app.parse_complete_callback(
       [&] { naris::set_verbosity(quiet ? naris::Verbosity::quiet : naris::Verbosity::normal); });
+  naris::app::add_segment_command(app);
   naris::app::add_mesh_command(app);
   naris::app::add_eog_command(app);
   try {

@@ -192,6 +192,10 @@ Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
         frame.spacing = Eigen::Vector3d(sp[0], sp[1], sp[2]);
         const double* o = image->GetOrigin();
         frame.origin += frame.direction * Eigen::Vector3d(o[0], o[1], o[2]);
+        // NIfTI coordinates are RAS; naris frames are LPS like DICOM and 3D Slicer's NRRD.
+        const Eigen::Matrix3d ras_to_lps = Eigen::Vector3d(-1, -1, 1).asDiagonal();
+        frame.direction = ras_to_lps * frame.direction;
+        frame.origin = ras_to_lps * frame.origin;
       }
     }
   } else if (ext == ".mha" || ext == ".mhd") {

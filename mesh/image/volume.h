@@ -1,6 +1,7 @@
 #pragma once
 // A 3D image on a regular grid with its physical frame: x = origin + D·diag(spacing)·(i,j,k).
-// Index ↔ physical conversion lives here and nowhere else.
+// Index ↔ physical conversion lives here and nowhere else. Physical coordinates are patient
+// LPS millimetres (DICOM's and 3D Slicer's convention); readers of RAS formats convert.
 #include <Eigen/Dense>
 #include <array>
 #include <cstddef>

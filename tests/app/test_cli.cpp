@@ -272,3 +272,49 @@ TEST_F(CliEog, BadRecordingsAreClearErrors) {
 }
 
 }  // namespace
+
+namespace {
+
+class CliSegment : public Cli {
+ protected:
+  // A 24³ CT-like float volume: tissue 40 HU, an air box (−1000 HU), noise of 20 HU.
+  fs::path ct() {
+    std::vector<float> v(24 * 24 * 24);
+    std::mt19937 rng(3);
+    std::normal_distribution<float> noise(0.0f, 20.0f);
+    for (int k = 0; k < 24; ++k)
+      for (int j = 0; j < 24; ++j)
+        for (int i = 0; i < 24; ++i) {
+          const bool air = i > 4 && i < 18 && j > 6 && j < 16 && k > 3 && k < 20;
+          v[static_cast<std::size_t>(i + 24 * (j + 24 * k))] =
+              (air ? -1000.0f : 40.0f) + noise(rng);
+        }
+    return nrrd("ct.nrrd", "float", "24 24 24", payload(v));
+  }
+};
+
+TEST_F(CliSegment, SegmentsThenMeshes) {
+  const fs::path in = ct();
+  const fs::path mask = dir_ / "out" / "airway.nrrd";
+  const CliRun r = naris("segment " + in.string() + " --seed 10,10,10 -o " + mask.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  // The air box spans i 5..17, j 7..15, k 4..19: 13·9·16 voxels.
+  EXPECT_NE(r.err.find("airway " + std::to_string(13 * 9 * 16) + " voxels"), std::string::npos)
+      << r.err;
+  const CliRun m = naris("mesh " + mask.string() + " -o " + (dir_ / "out" / "mesh.h5").string());
+  EXPECT_EQ(m.status, 0) << m.err;
+}
+
+TEST_F(CliSegment, BadSeedsAndThresholdsAreClearErrors) {
+  const fs::path in = ct();
+  const std::string out = " -o " + (dir_ / "out" / "a.nrrd").string();
+  expect_clean_failure(naris("segment " + in.string() + " --seed 30,3,3" + out),
+                       "outside the volume");
+  expect_clean_failure(naris("segment " + in.string() + " --seed 1,1,1" + out), "not inside");
+  expect_clean_failure(naris("segment " + in.string() + " --threshold -5000" + out),
+                       "outside the data range");
+  expect_clean_failure(naris("segment " + in.string() + " --threshold five" + out),
+                       "neither a number");
+}
+
+}  // namespace

@@ -55,32 +55,35 @@ vtkSmartPointer<vtkImageData> sample_image() {
   return image;
 }
 
-void expect_sample(const Volume<float>& v) {
+void expect_sample(const Volume<float>& v, bool ras = false) {
   EXPECT_EQ(v.dims(), (std::array<int, 3>{7, 5, 4}));
   EXPECT_NEAR(v.frame.spacing[0], 0.5, 1e-6);
   EXPECT_NEAR(v.frame.spacing[1], 0.25, 1e-6);
   EXPECT_NEAR(v.frame.spacing[2], 2.0, 1e-6);
-  EXPECT_NEAR(v.frame.origin[0], -3.0, 1e-6);
+  // A RAS format (NIfTI) comes back in LPS: x and y change sign.
+  EXPECT_NEAR(v.frame.origin[0], ras ? 3.0 : -3.0, 1e-6);
+  EXPECT_NEAR(v.frame.origin[1], ras ? -1.5 : 1.5, 1e-6);
   EXPECT_NEAR(v.frame.origin[2], 10.0, 1e-6);
+  EXPECT_NEAR(v.frame.direction(0, 0), ras ? -1.0 : 1.0, 1e-9);
   for (int n = 0; n < 140; ++n) EXPECT_EQ(v.values[static_cast<std::size_t>(n)], n * 1.5f - 40.0f);
 }
 
 template <class Writer>
-void round_trip(const char* name) {
+void round_trip(const char* name, bool ras = false) {
   const fs::path p = fs::temp_directory_path() / name;
   auto writer = vtkSmartPointer<Writer>::New();
   writer->SetInputData(sample_image());
   writer->SetFileName(p.c_str());
   writer->Write();
   VolumeInfo info;
-  expect_sample(read_volume(p, &info));
+  expect_sample(read_volume(p, &info), ras);
   EXPECT_EQ(info.pixel_type, "float");
   fs::remove(p);
   fs::remove(fs::path(p).replace_extension(".raw"));
 }
 
 TEST(ReadVolume, NiftiRoundTrip) {
-  round_trip<vtkNIFTIImageWriter>("naris-sample.nii");
+  round_trip<vtkNIFTIImageWriter>("naris-sample.nii", true);
 }
 TEST(ReadVolume, MetaImageRoundTrip) {
   round_trip<vtkMetaImageWriter>("naris-sample.mha");
