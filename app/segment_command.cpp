@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "image/read_volume.h"
+#include "image/resample.h"
 #include "image/segment.h"
 #include "io/atomic_file.h"
 
@@ -18,6 +19,8 @@ void add_segment_command(CLI::App& app) {
     std::string threshold = "auto", inside = "below";
     std::vector<std::string> seeds;
     bool all_components = false;
+    std::string rotate;
+    int decimate = 1;
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand(
@@ -35,12 +38,33 @@ void add_segment_command(CLI::App& app) {
                   "seed voxel i,j,k or point x,y,z mm in the airway; repeatable");
   cmd->add_flag("--all-components", o->all_components,
                 "keep every component (default: the largest)");
+  cmd->add_option("--rotate", o->rotate,
+                  "rotate the volume first, AXIS:DEGREES about image axis i, j or k (e.g. i:30); "
+                  "seeds in voxels then refer to the rotated grid, seeds in mm do not change");
+  cmd->add_option("--decimate", o->decimate, "average N×N blocks of each slice first")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   cmd->add_option("-o,--output", o->output, "labelmap NRRD")->capture_default_str();
   cmd->callback([o] {
     ensure_writable_folder(std::filesystem::absolute(o->output).parent_path());
     Stopwatch clock;
     VolumeInfo info;
-    const Volume<float> ct = read_volume(o->input, &info);
+    Volume<float> ct = read_volume(o->input, &info);
+    if (o->decimate > 1) ct = decimate_in_plane(ct, o->decimate);
+    if (!o->rotate.empty()) {
+      const auto colon = o->rotate.find(':');
+      const std::string axis = o->rotate.substr(0, colon);
+      if (colon == std::string::npos || (axis != "i" && axis != "j" && axis != "k"))
+        fail("--rotate '{}' not understood: give AXIS:DEGREES with AXIS i, j or k", o->rotate);
+      double degrees = 0.0;
+      try {
+        degrees = std::stod(o->rotate.substr(colon + 1));
+      } catch (const std::exception&) {
+        fail("--rotate '{}': the angle is not a number", o->rotate);
+      }
+      // Voxels brought in from outside the scan are the densest value: never airway.
+      ct = rotate_about_axis(ct, axis[0] - 'i', degrees, static_cast<float>(info.max_value));
+    }
     double threshold;
     if (o->threshold == "auto") {
       threshold = air_threshold(ct);

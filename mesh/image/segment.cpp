@@ -79,24 +79,34 @@ double air_threshold(const Volume<float>& ct) {
       if (b + d >= 0 && b + d < bins) sum += h[static_cast<std::size_t>(b + d)], ++n;
     s[static_cast<std::size_t>(b)] = sum / n;
   }
-  // Local minima between two higher bins; the one nearest −1000 HU.
-  double best = NAN, best_distance = INFINITY;
-  for (int b = 1; b + 1 < bins; ++b) {
-    const auto u = static_cast<std::size_t>(b);
-    if (!(s[u] < s[u - 1] && s[u] <= s[u + 1])) continue;
-    // A flat valley (an empty stretch between the peaks) is a plateau: take its centre.
-    int e = b;
-    while (e + 1 < bins && s[static_cast<std::size_t>(e + 1)] <= s[u] * (1.0 + 1e-12) + 1e-300) ++e;
-    const double left_peak = *std::max_element(s.begin(), s.begin() + b);
-    const double right_peak = *std::max_element(s.begin() + e + 1, s.end());
-    if (e + 1 >= bins || !(s[u] < 0.5 * std::min(left_peak, right_peak))) {  // not a real valley
-      b = e;
-      continue;
+  // The valley next to air: the air peak is the fullest bin below −500 HU, the tissue peak the
+  // fullest bin above it; the threshold is the centre of the valley floor between them. Noise
+  // dips on a peak's flank are not valleys.
+  double best = NAN;
+  auto bin_of = [&](double hu) {
+    return std::clamp(static_cast<int>((hu - lo) / width), 0, bins - 1);
+  };
+  const int air_end = bin_of(-500.0);
+  if (lo < -500.0 && air_end > 0) {
+    const int air = static_cast<int>(std::max_element(s.begin(), s.begin() + air_end) - s.begin());
+    const int tissue_start = std::min(bins - 1, air + std::max(1, static_cast<int>(200.0 / width)));
+    const int tissue =
+        static_cast<int>(std::max_element(s.begin() + tissue_start, s.end()) - s.begin());
+    if (tissue > air + 1) {
+      const auto low = std::min_element(s.begin() + air, s.begin() + tissue + 1);
+      const double floor = *low;
+      const double peak =
+          std::min(s[static_cast<std::size_t>(air)], s[static_cast<std::size_t>(tissue)]);
+      if (floor < 0.5 * peak) {
+        // The valley floor: the contiguous bins around the minimum within a tenth of the way up
+        // to the lower peak; sparse counts make the single lowest bin arbitrary, the band is not.
+        const double band = floor + 0.1 * (peak - floor);
+        int b0 = static_cast<int>(low - s.begin()), b1 = b0;
+        while (b0 - 1 > air && s[static_cast<std::size_t>(b0 - 1)] <= band) --b0;
+        while (b1 + 1 < tissue && s[static_cast<std::size_t>(b1 + 1)] <= band) ++b1;
+        best = lo + (0.5 * (b0 + b1) + 0.5) * width;
+      }
     }
-    const double value = lo + (0.5 * (b + e) + 0.5) * width;
-    b = e;
-    if (std::abs(value + 1000.0) < best_distance)
-      best = value, best_distance = std::abs(value + 1000.0);
   }
   if (std::isnan(best))
     fail(
