@@ -2,6 +2,7 @@
 
 #include <gdcmDirectory.h>
 #include <gdcmIPPSorter.h>
+#include <gdcmScanner.h>
 #include <gdcmTrace.h>
 #include <vtkCallbackCommand.h>
 #include <vtkDataArray.h>
@@ -238,6 +239,27 @@ Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
           "{}: the slices are not evenly spaced; resample the series to a uniform spacing "
           "before meshing",
           path.string());
+    // Every slice must have the same size: GDCM's VTK reader does not check (it crashes).
+    gdcm::Scanner scanner;
+    const gdcm::Tag rows_tag(0x0028, 0x0010), columns_tag(0x0028, 0x0011);
+    scanner.AddTag(rows_tag);
+    scanner.AddTag(columns_tag);
+    if (!scanner.Scan(sorter.GetFilenames()))
+      fail("{}: cannot read the slices' image size", path.string());
+    std::string first_size;
+    for (const auto& f : sorter.GetFilenames()) {
+      const char* r = scanner.GetValue(f.c_str(), rows_tag);
+      const char* c = scanner.GetValue(f.c_str(), columns_tag);
+      if (!r || !c) fail("{}: slice {} has no Rows/Columns", path.string(), f);
+      const std::string size = fmt::format("{}×{}", c, r);
+      if (first_size.empty())
+        first_size = size;
+      else if (size != first_size)
+        fail(
+            "{}: slices of unequal size in the series ({} and {} in {}); a volume needs equal "
+            "slices",
+            path.string(), first_size, size, fs::path(f).filename().string());
+    }
     auto names = vtkSmartPointer<vtkStringArray>::New();
     for (const auto& f : sorter.GetFilenames()) names->InsertNextValue(f);
     auto reader = vtkSmartPointer<vtkGDCMImageReader>::New();

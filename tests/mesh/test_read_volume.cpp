@@ -120,6 +120,36 @@ TEST(ReadVolume, DicomSeriesFolder) {
   fs::remove_all(dir);
 }
 
+TEST(ReadVolume, DicomSeriesWithUnevenSpacingIsRefused) {
+  std::vector<std::vector<std::int16_t>> slices(4, std::vector<std::int16_t>(6 * 5, 100));
+  const fs::path dir = fs::temp_directory_path() / "naris-dicom-uneven";
+  fs::remove_all(dir);
+  testing::write_dicom_series(dir, 6, 5, slices, 0.4, 0.4, {0.0, 3.0, 7.0, 10.0});
+  try {
+    read_volume(dir);
+    FAIL() << "an unevenly spaced series was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not evenly spaced"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(ReadVolume, DicomSlicesOfUnequalSizeAreRefused) {
+  const fs::path dir = fs::temp_directory_path() / "naris-dicom-unequal";
+  fs::remove_all(dir);
+  std::vector<std::vector<std::int16_t>> a(2, std::vector<std::int16_t>(6 * 5, 100));
+  std::vector<std::vector<std::int16_t>> b(2, std::vector<std::int16_t>(8 * 5, 100));
+  testing::write_dicom_series(dir / "a", 6, 5, a, 0.4, 0.4, {0.0, 3.0});
+  testing::write_dicom_series(dir / "b", 8, 5, b, 0.4, 0.4, {6.0, 9.0});
+  for (const auto& sub : {"a", "b"})
+    for (const auto& f : fs::directory_iterator(dir / sub))
+      fs::rename(f.path(), dir / (std::string(sub) + f.path().filename().string()));
+  fs::remove(dir / "a");
+  fs::remove(dir / "b");
+  EXPECT_THROW(read_volume(dir), Error);
+  fs::remove_all(dir);
+}
+
 TEST(ReadVolume, MissingFileIsAClearError) {
   try {
     read_volume("/nonexistent/scan.nrrd");
