@@ -65,3 +65,39 @@ TEST(Hsr, SlicesOfDifferentSizeAreAnError) {
 
 }  // namespace
 }  // namespace naris
+
+#include "image/interpolate_slices.h"
+
+namespace naris {
+namespace {
+
+// Whole volumes: slices inserted along an axis keep the acquired ones and the frame.
+TEST(InterpolateSlices, InsertsSlicesAlongTheAxisAndKeepsTheAcquiredOnes) {
+  Volume<float> v;
+  v.frame.dims = {3, 17, 17};
+  v.frame.spacing = Eigen::Vector3d(3.0, 0.5, 0.5);
+  v.values.assign(v.frame.voxel_count(), 0.0f);
+  for (int i = 0; i < 3; ++i)
+    for (int k = 2 + 2 * i; k < 10 + 2 * i; ++k)
+      for (int j = 1 + 3 * i; j < 9 + 3 * i; ++j)
+        v.at(i, j, k) = 1.0f;  // a square moving in (j, k)
+  for (const char* m : {"hsr", "linear", "shape"}) {
+    const Volume<float> out = interpolate_slices(v, 0, 2, parse_slice_method(m), {4, 3, 50}, 2);
+    ASSERT_EQ(out.dims(), (std::array<int, 3>{7, 17, 17})) << m;
+    EXPECT_DOUBLE_EQ(out.frame.spacing[0], 1.0);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 17; ++j)
+        for (int k = 0; k < 17; ++k) ASSERT_EQ(out.at(3 * i, j, k), v.at(i, j, k)) << m;
+  }
+  // HSR moves the square: the middle slice between acquired slices 0 and 1 is the square at
+  // its halfway position (shifted by 1.5 in j and 1 in k), up to a pixel of rounding.
+  const Volume<float> h = interpolate_slices(v, 0, 1, SliceMethod::hsr, {4, 3, 50}, 1);
+  int count = 0;
+  for (int j = 0; j < 17; ++j)
+    for (int k = 0; k < 17; ++k) count += h.at(1, j, k) == 1.0f;
+  EXPECT_NEAR(count, 64, 10);
+  EXPECT_THROW(parse_slice_method("cubic"), Error);
+}
+
+}  // namespace
+}  // namespace naris

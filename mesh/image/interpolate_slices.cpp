@@ -1,0 +1,94 @@
+#include "image/interpolate_slices.h"
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
+
+#include "core/error.h"
+
+namespace naris {
+namespace {
+
+// In-slice axes for a slice across `axis`, in increasing order.
+std::pair<int, int> plane_axes(int axis) {
+  return axis == 0 ? std::pair{1, 2} : axis == 1 ? std::pair{0, 2} : std::pair{0, 1};
+}
+
+}  // namespace
+
+SliceMethod parse_slice_method(const std::string& name) {
+  if (name == "hsr") return SliceMethod::hsr;
+  if (name == "linear") return SliceMethod::linear;
+  if (name == "shape") return SliceMethod::shape;
+  fail("unknown interpolation method '{}' (hsr, linear or shape)", name);
+}
+
+Image2D slice_across(const Volume<float>& v, int axis, int index) {
+  const auto [a, b] = plane_axes(axis);
+  Image2D im{v.dims()[a], v.dims()[b], {}};
+  im.v.resize(static_cast<std::size_t>(im.width) * im.height);
+  std::array<int, 3> ijk{};
+  ijk[axis] = index;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      ijk[a] = x;
+      ijk[b] = y;
+      im.at(x, y) = v.at(ijk[0], ijk[1], ijk[2]);
+    }
+  return im;
+}
+
+void set_slice_across(Volume<float>& v, int axis, int index, const Image2D& im) {
+  const auto [a, b] = plane_axes(axis);
+  std::array<int, 3> ijk{};
+  ijk[axis] = index;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      ijk[a] = x;
+      ijk[b] = y;
+      v.at(ijk[0], ijk[1], ijk[2]) = static_cast<float>(im.at(x, y));
+    }
+}
+
+Volume<float> interpolate_slices(const Volume<float>& v, int axis, int k, SliceMethod method,
+                                 const HsrOptions& hsr, int threads) {
+  if (axis < 0 || axis > 2) fail("slice axis must be 0, 1 or 2 (i, j or k)");
+  if (k < 0) fail("the number of slices to insert must not be negative");
+  const int n = v.dims()[axis];
+  if (n < 2) fail("a volume with a single slice along axis {} cannot be interpolated", axis);
+  const bool mask =
+      std::all_of(v.values.begin(), v.values.end(), [](float x) { return x == 0.0f || x == 1.0f; });
+  Volume<float> out;
+  out.frame = v.frame;
+  out.frame.dims[axis] = (n - 1) * (k + 1) + 1;
+  out.frame.spacing[axis] /= (k + 1);
+  out.values.assign(out.frame.voxel_count(), 0.0f);
+  std::atomic<int> next{0};
+  auto worker = [&] {
+    for (int p; (p = next++) < n - 1;) {
+      const Image2D a = slice_across(v, axis, p), b = slice_across(v, axis, p + 1);
+      set_slice_across(out, axis, p * (k + 1), a);
+      if (p + 1 == n - 1) set_slice_across(out, axis, (p + 1) * (k + 1), b);
+      // I2 is the lower slice (s = 0), I1 the upper (s = 1).
+      Displacement d;
+      if (method == SliceMethod::hsr && k > 0) d = register_hsr(b, a, hsr);
+      for (int q = 1; q <= k; ++q) {
+        const double s = static_cast<double>(q) / (k + 1);
+        Image2D im = method == SliceMethod::hsr      ? interpolate_hsr(b, a, d, s)
+                     : method == SliceMethod::linear ? interpolate_linear(b, a, s)
+                                                     : interpolate_shape(b, a, s);
+        if (mask && method != SliceMethod::shape)
+          for (double& x : im.v) x = x > 0.5 ? 1.0 : 0.0;
+        set_slice_across(out, axis, p * (k + 1) + q, im);
+      }
+    }
+  };
+  const unsigned count = threads > 0 ? static_cast<unsigned>(threads)
+                                     : std::max(1u, std::thread::hardware_concurrency());
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < count; ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  return out;
+}
+
+}  // namespace naris
