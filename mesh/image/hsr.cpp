@@ -84,6 +84,28 @@ struct Grid {
   }
 };
 
+// One pixel of I2 under the current field: its four control points and bilinear weights, the
+// displaced position in I1 and I1's gradient there (central differences): G_i of eq. 2.8.
+struct Pixel {
+  std::size_t j[4];
+  double w[4];
+  double px, py, gx, gy;
+  Pixel(const Image2D& i1, const Grid& g, int x, int y) {
+    int cx, cy;
+    double fx, fy;
+    g.cell(x, y, cx, cy, fx, fy);
+    w[0] = (1 - fx) * (1 - fy), w[1] = fx * (1 - fy), w[2] = (1 - fx) * fy, w[3] = fx * fy;
+    j[0] = g.id(cx, cy), j[1] = g.id(cx + 1, cy), j[2] = g.id(cx, cy + 1),
+    j[3] = g.id(cx + 1, cy + 1);
+    double du = 0, dv = 0;
+    for (int k = 0; k < 4; ++k) du += w[k] * g.u[j[k]], dv += w[k] * g.v[j[k]];
+    px = x + du;
+    py = y + dv;
+    gx = 0.5 * (sample(i1, px + 1, py) - sample(i1, px - 1, py));
+    gy = 0.5 * (sample(i1, px, py + 1) - sample(i1, px, py - 1));
+  }
+};
+
 double msd(const Image2D& i1, const Image2D& i2, const Grid& g) {
   double s = 0.0;
   for (int y = 0; y < i2.height; ++y)
@@ -110,19 +132,11 @@ void refine(const Image2D& i1, const Image2D& i2, Grid& g, int iterations) {
     double error = 0.0;
     for (int y = 0; y < i2.height; ++y)
       for (int x = 0; x < i2.width; ++x) {
-        int cx, cy;
-        double fx, fy;
-        g.cell(x, y, cx, cy, fx, fy);
-        const double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-        const std::size_t j[4] = {g.id(cx, cy), g.id(cx + 1, cy), g.id(cx, cy + 1),
-                                  g.id(cx + 1, cy + 1)};
-        double du = 0, dv = 0;
-        for (int k = 0; k < 4; ++k) du += w[k] * g.u[j[k]], dv += w[k] * g.v[j[k]];
-        const double px = x + du, py = y + dv;
-        const double e = sample(i1, px, py) - i2.at(x, y);
-        // G_i: the gradient of I1 at the displaced position (central differences).
-        const double gx = 0.5 * (sample(i1, px + 1, py) - sample(i1, px - 1, py));
-        const double gy = 0.5 * (sample(i1, px, py + 1) - sample(i1, px, py - 1));
+        const Pixel q(i1, g, x, y);
+        const auto& j = q.j;
+        const auto& w = q.w;
+        const double gx = q.gx, gy = q.gy;
+        const double e = sample(i1, q.px, q.py) - i2.at(x, y);
         error += e * e;
         for (int k = 0; k < 4; ++k) {
           gu[j[k]] += 2 * e * gx * w[k];  // eq. 2.8
@@ -148,20 +162,10 @@ void refine(const Image2D& i1, const Image2D& i2, Grid& g, int iterations) {
     double ghg = 0.0;
     for (int y = 0; y < i2.height; ++y)
       for (int x = 0; x < i2.width; ++x) {
-        int cx, cy;
-        double fx, fy;
-        g.cell(x, y, cx, cy, fx, fy);
-        const double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-        const std::size_t j[4] = {g.id(cx, cy), g.id(cx + 1, cy), g.id(cx, cy + 1),
-                                  g.id(cx + 1, cy + 1)};
-        double du = 0, dv = 0, qu = 0, qv = 0;
-        for (int k = 0; k < 4; ++k) {
-          du += w[k] * g.u[j[k]], dv += w[k] * g.v[j[k]];
-          qu += w[k] * pu[j[k]], qv += w[k] * pv[j[k]];
-        }
-        const double px = x + du, py = y + dv;
-        const double gx = 0.5 * (sample(i1, px + 1, py) - sample(i1, px - 1, py));
-        const double gy = 0.5 * (sample(i1, px, py + 1) - sample(i1, px, py - 1));
+        const Pixel q(i1, g, x, y);
+        double qu = 0, qv = 0;
+        for (int k = 0; k < 4; ++k) qu += q.w[k] * pu[q.j[k]], qv += q.w[k] * pv[q.j[k]];
+        const double gx = q.gx, gy = q.gy;
         ghg += 2 * (gx * qu + gy * qv) * (gx * qu + gy * qv);
       }
     if (!(ghg > 0.0)) break;

@@ -23,31 +23,37 @@ SliceMethod parse_slice_method(const std::string& name) {
   fail("unknown interpolation method '{}' (hsr, linear or shape)", name);
 }
 
+namespace {
+
+// Calls f(x, y, i, j, k) for every pixel (x, y) of the slice across `axis` at `index`.
+template <class F>
+void for_each_in_slice(const std::array<int, 3>& dims, int axis, int index, F&& f) {
+  const auto [a, b] = plane_axes(axis);
+  std::array<int, 3> ijk{};
+  ijk[axis] = index;
+  for (int y = 0; y < dims[b]; ++y)
+    for (int x = 0; x < dims[a]; ++x) {
+      ijk[a] = x;
+      ijk[b] = y;
+      f(x, y, ijk[0], ijk[1], ijk[2]);
+    }
+}
+
+}  // namespace
+
 Image2D slice_across(const Volume<float>& v, int axis, int index) {
   const auto [a, b] = plane_axes(axis);
   Image2D im{v.dims()[a], v.dims()[b], {}};
   im.v.resize(static_cast<std::size_t>(im.width) * im.height);
-  std::array<int, 3> ijk{};
-  ijk[axis] = index;
-  for (int y = 0; y < im.height; ++y)
-    for (int x = 0; x < im.width; ++x) {
-      ijk[a] = x;
-      ijk[b] = y;
-      im.at(x, y) = v.at(ijk[0], ijk[1], ijk[2]);
-    }
+  for_each_in_slice(v.dims(), axis, index,
+                    [&](int x, int y, int i, int j, int k) { im.at(x, y) = v.at(i, j, k); });
   return im;
 }
 
 void set_slice_across(Volume<float>& v, int axis, int index, const Image2D& im) {
-  const auto [a, b] = plane_axes(axis);
-  std::array<int, 3> ijk{};
-  ijk[axis] = index;
-  for (int y = 0; y < im.height; ++y)
-    for (int x = 0; x < im.width; ++x) {
-      ijk[a] = x;
-      ijk[b] = y;
-      v.at(ijk[0], ijk[1], ijk[2]) = static_cast<float>(im.at(x, y));
-    }
+  for_each_in_slice(v.dims(), axis, index, [&](int x, int y, int i, int j, int k) {
+    v.at(i, j, k) = static_cast<float>(im.at(x, y));
+  });
 }
 
 Volume<float> interpolate_slices(const Volume<float>& v, int axis, int k, SliceMethod method,
