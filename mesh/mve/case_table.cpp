@@ -190,7 +190,7 @@ constexpr int kFanFromApex = -2;
 // Returns false when x lies on a cube face whose polygons are not a fan from x: that face
 // would then be split differently from the neighbour's side.
 bool cone_from(int x, const std::vector<Polygon>& face_polys, const std::vector<int>& poly_face,
-               const std::vector<std::vector<int>>& loops, int component_centre_of,
+               const std::vector<std::vector<int>>& loops, bool apex_is_centre,
                const std::vector<int>& component_points, int fan, Tessellation& tess) {
   if (x < kPrivatePoint0) {
     for (int f : faces_touching(x))
@@ -199,7 +199,7 @@ bool cone_from(int x, const std::vector<Polygon>& face_polys, const std::vector<
           return false;
   }
   int next_private = kPrivatePoint0;
-  if (component_centre_of >= 0) {
+  if (apex_is_centre) {
     tess.privates.push_back({{component_points.begin(), component_points.end()}});
     x = next_private++;
   }
@@ -345,8 +345,8 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
       const bool centre = x < 0;
       const std::vector<int>& centre_of =
           x == -2 ? inside_vertices : (x == -3 ? cloops.front() : cpoints);
-      if (!cone_from(centre ? kPrivatePoint0 : x, cpolys, cface, cloops, centre ? 0 : -1, centre_of,
-                     fan, tess))
+      if (!cone_from(centre ? kPrivatePoint0 : x, cpolys, cface, cloops, centre, centre_of, fan,
+                     tess))
         continue;
       int failures = 0;
       Points pts;
