@@ -7,6 +7,7 @@
 #include <random>
 
 #include "core/error.h"
+#include "mve/fill_component.h"
 
 namespace naris::mve {
 
@@ -149,7 +150,7 @@ struct Sampler {
   }
 };
 
-using Points = std::array<Eigen::Vector3d, 64>;
+using Points = std::array<Eigen::Vector3d, kMaxLocalPoints>;
 
 void sample_points(const CaseEntry& entry, const std::array<double, 12>& t, Points& x) {
   for (int v = 0; v < 8; ++v) x[v] = Eigen::Vector3d(kCorner[v][0], kCorner[v][1], kCorner[v][2]);
@@ -159,29 +160,6 @@ void sample_points(const CaseEntry& entry, const std::array<double, 12>& t, Poin
     const auto& fe = entry.face_point_edges[f];
     if (fe[0] >= 0) x[kFacePoint0 + f] = 0.5 * (x[kEdgePoint0 + fe[0]] + x[kEdgePoint0 + fe[1]]);
   }
-}
-
-double min_cell_volume(const Tessellation& tess, Points& x) {
-  int next = kPrivatePoint0;
-  for (const auto& pp : tess.privates) {
-    Eigen::Vector3d m = Eigen::Vector3d::Zero();
-    for (auto s : pp.mean_of) m += x[s];
-    x[next++] = m / static_cast<double>(pp.mean_of.size());
-  }
-  auto tet = [&](int a, int b, int c, int d) {
-    return (x[b] - x[a]).cross(x[c] - x[a]).dot(x[d] - x[a]) / 6.0;
-  };
-  double vmin = INFINITY;
-  for (const auto& cell : tess.cells) {
-    const auto& p = cell.p;
-    if (cell.size == 4) {
-      vmin = std::min(vmin, tet(p[0], p[1], p[2], p[3]));
-    } else {
-      vmin = std::min({vmin, tet(p[0], p[1], p[2], p[4]), tet(p[0], p[2], p[3], p[4]),
-                       tet(p[0], p[1], p[3], p[4]), tet(p[1], p[2], p[3], p[4])});
-    }
-  }
-  return vmin;
 }
 
 constexpr int kFanFromApex = -2;
@@ -252,7 +230,6 @@ bool cone_from(int x, const std::vector<Polygon>& face_polys, const std::vector<
   };
   for (const auto& poly : face_polys) add_cone(poly);
   for (const auto& poly : tess.iso_triangles) add_cone(poly);
-  tess.apex = x;
   return true;
 }
 
@@ -352,9 +329,8 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
       Points pts;
       for (const auto& t : sampler.params) {
         sample_points(entry, t, pts);
-        if (!(min_cell_volume(tess, pts) > 1e-14)) ++failures;
+        if (!(place_and_measure(tess, pts) > 6e-14)) ++failures;  // 6× volume
       }
-      tess.robust = failures == 0;
       ranked.push_back({{failures, static_cast<int>(tess.cells.size())}, std::move(tess)});
     }
     std::stable_sort(ranked.begin(), ranked.end(),
@@ -367,7 +343,7 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
       sample_points(entry, mid, pts);
       for (std::size_t r = 0; r < std::min<std::size_t>(ranked.size(), 6); ++r) {
         Points copy = pts;
-        if (min_cell_volume(ranked[r].second, copy) > 1e-12) {
+        if (place_and_measure(ranked[r].second, copy) > 6e-12) {
           comp.midpoint_candidate = static_cast<int>(r);
           break;
         }

@@ -64,8 +64,6 @@ struct Tessellation {
   std::vector<PrivatePoint> privates;  // local ids 26, 27, ... in order
   std::vector<CellTemplate> cells;
   std::vector<Polygon> iso_triangles;
-  int apex = -1;        // local id of the cone apex
-  bool robust = false;  // valid for every sampled isopoint placement
 };
 
 struct Component {

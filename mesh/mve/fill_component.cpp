@@ -15,7 +15,8 @@ double tet6(const Points& x, int a, int b, int c, int d) {
   return (x[b] - x[a]).cross(x[c] - x[a]).dot(x[d] - x[a]);
 }
 
-// Smallest 6× volume over a candidate's cells, after placing its private points in x.
+}  // namespace
+
 double place_and_measure(const Tessellation& t, Points& x) {
   int next = kPrivatePoint0;
   for (const auto& pp : t.privates) {
@@ -36,6 +37,8 @@ double place_and_measure(const Tessellation& t, Points& x) {
   }
   return vmin;
 }
+
+namespace {
 
 void emit(const Tessellation& t, const Points& x, ComponentFill& out) {
   for (std::size_t n = 0; n < t.privates.size(); ++n) out.privates.push_back(x[kPrivatePoint0 + n]);
@@ -179,13 +182,11 @@ void fill_component(const Component& comp, const Eigen::Vector3d& cube_min, Poin
   for (const auto& cand : comp.candidates) {
     const double v = place_and_measure(cand, x);
     if (v > kMinVolume6) {
-      out.used_fallback = &cand != &comp.candidates.front();
       emit(cand, x, out);
       return;
     }
     if (v > best) best = v, least_bad = &cand;
   }
-  out.used_fallback = true;
   if (search_apex(comp, cube_min, x, out)) return;
   // Nothing valid: report it and emit the least inverted candidate so the caller can count it.
   out.resolved = false;
@@ -204,7 +205,6 @@ void fill_component_binary(const Component& comp, const Eigen::Vector3d& cube_mi
     for (auto s : pp.mean_of) m += x[s];
     x[next++] = m / static_cast<double>(pp.mean_of.size());
   }
-  out.used_fallback = comp.midpoint_candidate != 0;
   emit(t, x, out);
 }
 

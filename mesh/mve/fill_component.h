@@ -20,14 +20,12 @@ struct ComponentFill {
   std::vector<std::array<std::uint8_t, 5>> pyramids;
   std::vector<std::array<std::uint8_t, 3>> iso_triangles;
   std::vector<Eigen::Vector3d> privates;
-  bool used_fallback = false;  // not the table's first candidate
-  bool resolved = true;        // false: nothing valid was found (cells are then unusable)
+  bool resolved = true;  // false: nothing valid was found (cells are then unusable)
   void clear() {
     tets.clear();
     pyramids.clear();
     iso_triangles.clear();
     privates.clear();
-    used_fallback = false;
     resolved = true;
   }
 };
@@ -39,6 +37,10 @@ void fill_component(const Component& comp, const Eigen::Vector3d& cube_min,
 
 // For binary fields: the candidate known in advance to be valid at midpoint isopoints (its
 // private points are still placed from x). Falls back to fill_component when there is none.
+// Smallest 6× tetrahedron volume over a candidate's cells (both diagonal splits of each pyramid
+// base), after placing its private points in x (from id kPrivatePoint0 on).
+double place_and_measure(const Tessellation& t, std::array<Eigen::Vector3d, kMaxLocalPoints>& x);
+
 void fill_component_binary(const Component& comp, const Eigen::Vector3d& cube_min,
                            std::array<Eigen::Vector3d, kMaxLocalPoints>& x, ComponentFill& out);
 

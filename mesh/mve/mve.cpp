@@ -38,15 +38,18 @@ class Mesher {
   Mesher(const FieldSource& field, const MveOptions& options, HybridMesh& mesh, MveStats& stats)
       : field_(field), opt_(options), mesh_(mesh), stats_(stats) {
     const auto& dims = field.frame().dims;
+    std::array<int, 3> n{};
     for (int a = 0; a < 3; ++a) {
       lo_[a] = std::max(0, options.crop.lo[a]);
-      hi_[a] = options.crop.hi[a] < 0 ? dims[a] - 1 : std::min(options.crop.hi[a], dims[a] - 1);
-      if (hi_[a] - lo_[a] < 1)
-        fail("the crop box keeps fewer than two voxels along axis {} ({}..{})", a, lo_[a], hi_[a]);
+      const int hi =
+          options.crop.hi[a] < 0 ? dims[a] - 1 : std::min(options.crop.hi[a], dims[a] - 1);
+      if (hi - lo_[a] < 1)
+        fail("the crop box keeps fewer than two voxels along axis {} ({}..{})", a, lo_[a], hi);
+      n[a] = hi - lo_[a] + 1;
     }
-    nx_ = hi_[0] - lo_[0] + 1;
-    ny_ = hi_[1] - lo_[1] + 1;
-    nz_ = hi_[2] - lo_[2] + 1;
+    nx_ = n[0];
+    ny_ = n[1];
+    nz_ = n[2];
     const std::size_t plane = static_cast<std::size_t>(nx_) * ny_;
     for (int s = 0; s < 2; ++s) {
       value_[s].resize(plane);
@@ -287,7 +290,6 @@ class Mesher {
     if (config == 0) return;
     NodeId ids[kMaxLocalPoints];
     if (config == 255) {
-      ++stats_.inside_cubes;
       std::array<NodeId, 8> hex;
       for (int v = 0; v < 8; ++v)
         hex[v] = ids[v] = vertex_node(i + kCorner[v][0], j + kCorner[v][1], kCorner[v][2]);
@@ -307,7 +309,6 @@ class Mesher {
         add_border_faces(i, j, case_entry(255, 0), ids);
       return;
     }
-    ++stats_.boundary_cubes;
 
     // Ambiguous faces: the bilinear saddle value decides (eq. 3.1–3.4). With the inside diagonal
     // (a, c) and the outside one (b, d), the saddle is inside iff a·c > b·d; ties separate.
@@ -347,7 +348,6 @@ class Mesher {
         fill_component_binary(comp, cube_min, x_, fill_);
       else
         fill_component(comp, cube_min, x_, fill_);
-      stats_.fallback_cubes += fill_.used_fallback;
       stats_.unresolved_cubes += !fill_.resolved;
       for (std::size_t n = 0; n < fill_.privates.size(); ++n)
         ids[kPrivatePoint0 + n] = add_node(fill_.privates[n]);
@@ -371,7 +371,7 @@ class Mesher {
   const MveOptions& opt_;
   HybridMesh& mesh_;
   MveStats& stats_;
-  std::array<int, 3> lo_{}, hi_{};
+  std::array<int, 3> lo_{};
   int nx_ = 0, ny_ = 0, nz_ = 0, k_ = 0;
   std::vector<float> raw_;
   std::vector<float> value_[2];
@@ -444,7 +444,6 @@ void keep_largest_component(HybridMesh& mesh, BigVector<NodeId>& parent, MveStat
 
 HybridMesh march_volume_elements(const FieldSource& field, const MveOptions& options,
                                  MveStats* stats_out) {
-  Stopwatch clock;
   MveStats stats;
   HybridMesh mesh;
   Mesher mesher(field, options, mesh, stats);
@@ -465,7 +464,6 @@ HybridMesh march_volume_elements(const FieldSource& field, const MveOptions& opt
                          options.crop.lo[2] > 0 ? options.crop.lo[2] : 0);
   for (auto& x : mesh.nodes) x = frame.origin + m * (x + offset);
   if (m.determinant() < 0.0) flip_orientation(mesh);
-  stats.seconds = clock.seconds();
   if (stats_out) *stats_out = stats;
   return mesh;
 }

@@ -50,18 +50,13 @@ struct MveOptions {
   // Isopoints keep at least this fraction of an edge from its vertices so that no cell is flat.
   double isopoint_margin = 1e-3;
   bool keep_largest_component = true;
-  bool show_progress = true;
 };
 
 struct MveStats {
-  std::size_t boundary_cubes = 0;
-  std::size_t inside_cubes = 0;
-  std::size_t fallback_cubes = 0;    // a later candidate tessellation had to be used
   std::size_t unresolved_cubes = 0;  // no candidate gave positive volumes (should stay 0)
   std::size_t components = 0;        // connected mesh components before filtering
   std::size_t dropped_components = 0;
   std::size_t dropped_cells = 0;
-  double seconds = 0.0;
 };
 
 // Meshes the inside of the field in physical coordinates (mm). Throws naris::Error when nothing

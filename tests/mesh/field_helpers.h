@@ -40,7 +40,6 @@ inline double boundary_volume(const HybridMesh& m) {
 inline mve::MveOptions quiet_options() {
   mve::MveOptions o;
   o.keep_largest_component = false;
-  o.show_progress = false;
   return o;
 }
 
