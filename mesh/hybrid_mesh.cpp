@@ -40,16 +40,14 @@ double pyramid_volume(const HybridMesh& m, const std::array<NodeId, 5>& p) {
 
 double hex_volume(const HybridMesh& m, const std::array<NodeId, 8>& h) {
   // Divergence theorem over the six (possibly warped) faces, each split from its centroid.
-  static constexpr int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                                      {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
   double v = 0.0;
-  for (const auto& f : faces) {
+  for (const auto& f : kHexFaces) {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (int n : f) c += m.nodes[h[n]];
+    for (int n : f.v) c += m.nodes[h[n]];
     c /= 4.0;
     for (int e = 0; e < 4; ++e) {
-      const auto& a = m.nodes[h[f[e]]];
-      const auto& b = m.nodes[h[f[(e + 1) % 4]]];
+      const auto& a = m.nodes[h[f.v[e]]];
+      const auto& b = m.nodes[h[f.v[(e + 1) % 4]]];
       v += c.dot(a.cross(b)) / 6.0;
     }
   }

@@ -31,6 +31,32 @@ struct HybridMesh {
   int add_patch(const std::string& name);       // returns the existing id if present
 };
 
+// The outward faces of each cell type, as local node indices in VTK order (a triangle's fourth
+// entry is unused). Every piece of code that walks cell faces uses these tables.
+struct CellFace {
+  int size;
+  std::array<int, 4> v;
+};
+inline constexpr std::array<CellFace, 4> kTetFaces = {
+    {{3, {0, 2, 1, -1}}, {3, {0, 1, 3, -1}}, {3, {1, 2, 3, -1}}, {3, {0, 3, 2, -1}}}};
+inline constexpr std::array<CellFace, 5> kPyramidFaces = {{{4, {0, 3, 2, 1}},
+                                                           {3, {0, 1, 4, -1}},
+                                                           {3, {1, 2, 4, -1}},
+                                                           {3, {2, 3, 4, -1}},
+                                                           {3, {3, 0, 4, -1}}}};
+inline constexpr std::array<CellFace, 6> kHexFaces = {{{4, {0, 3, 2, 1}},
+                                                       {4, {4, 5, 6, 7}},
+                                                       {4, {0, 1, 5, 4}},
+                                                       {4, {2, 3, 7, 6}},
+                                                       {4, {1, 2, 6, 5}},
+                                                       {4, {0, 4, 7, 3}}}};
+// The faces of a cell with 4, 5 or 8 nodes.
+inline std::span<const CellFace> cell_faces(int nodes) {
+  if (nodes == 4) return kTetFaces;
+  if (nodes == 5) return kPyramidFaces;
+  return kHexFaces;
+}
+
 // Calls f(nodes, patch) for every boundary face, triangles then quadrilaterals; `nodes` is a
 // std::span over the face's node ids and `patch` its patch id (assignable).
 template <class F>

@@ -11,15 +11,6 @@
 namespace naris {
 namespace {
 
-// Outward faces of each cell type in VTK order.
-constexpr std::array<std::array<int, 3>, 4> kTetFaces = {
-    {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}};
-constexpr std::array<std::array<int, 3>, 4> kPyramidTris = {
-    {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}};
-constexpr std::array<int, 4> kPyramidBase = {0, 3, 2, 1};
-constexpr std::array<std::array<int, 4>, 6> kHexFaces = {
-    {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}}};
-
 struct FaceUse {
   std::array<NodeId, 4> key;    // sorted node ids, padded with the max value for triangles
   std::array<NodeId, 4> cycle;  // the cycle rotated to start at its smallest node
@@ -80,14 +71,19 @@ MeshCheck check_mesh(const HybridMesh& m) {
     r.min_volume = std::min(r.min_volume, v);
     if (!(v > 0.0)) ++r.nonpositive_cells;
   };
+  // A cell's faces from the shared tables; its edges are those of its faces (duplicates go
+  // when the edges are sorted).
+  auto add_cell = [&](const auto& c) {
+    for (const auto& f : cell_faces(static_cast<int>(c.size()))) {
+      NodeId n[4];
+      for (int k = 0; k < f.size; ++k) n[k] = c[f.v[k]];
+      faces.push_back(make_face(n, f.size, 0));
+      for (int k = 0; k < f.size; ++k) add_edge(n[k], n[(k + 1) % f.size]);
+    }
+  };
   for (const auto& t : m.tets) {
     note_volume(tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]));
-    for (const auto& f : kTetFaces) {
-      const NodeId n[3] = {t[f[0]], t[f[1]], t[f[2]]};
-      faces.push_back(make_face(n, 3, 0));
-    }
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) add_edge(t[a], t[b]);
+    add_cell(t);
   }
   for (const auto& p : m.pyramids) {
     // Every sub-tetrahedron of both diagonal splits must be positive for a valid pyramid.
@@ -96,27 +92,11 @@ MeshCheck check_mesh(const HybridMesh& m) {
                           tet_volume(x[p[0]], x[p[2]], x[p[3]], x[p[4]]),
                           tet_volume(x[p[0]], x[p[1]], x[p[3]], x[p[4]]),
                           tet_volume(x[p[1]], x[p[2]], x[p[3]], x[p[4]])}));
-    for (const auto& f : kPyramidTris) {
-      const NodeId n[3] = {p[f[0]], p[f[1]], p[f[2]]};
-      faces.push_back(make_face(n, 3, 0));
-    }
-    const NodeId base[4] = {p[kPyramidBase[0]], p[kPyramidBase[1]], p[kPyramidBase[2]],
-                            p[kPyramidBase[3]]};
-    faces.push_back(make_face(base, 4, 0));
-    for (int a = 0; a < 4; ++a) {
-      add_edge(p[a], p[(a + 1) % 4]);
-      add_edge(p[a], p[4]);
-    }
+    add_cell(p);
   }
   for (const auto& h : m.hexes) {
     note_volume(hex_volume(m, h));
-    for (const auto& f : kHexFaces) {
-      const NodeId n[4] = {h[f[0]], h[f[1]], h[f[2]], h[f[3]]};
-      faces.push_back(make_face(n, 4, 0));
-    }
-    static constexpr int kHexEdges[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
-                                             {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
-    for (const auto& e : kHexEdges) add_edge(h[e[0]], h[e[1]]);
+    add_cell(h);
   }
   std::vector<std::pair<NodeId, NodeId>> boundary_edges;
   for (const auto& t : m.boundary_tris) {

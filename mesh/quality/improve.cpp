@@ -62,15 +62,6 @@ bool has(const Face& f, NodeId n) {
   return std::find(f.v.begin(), f.v.begin() + f.size, n) != f.v.begin() + f.size;
 }
 
-const std::vector<std::vector<int>>& faces_of(const Cell& c) {
-  static const std::vector<std::vector<int>> tet{{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
-  static const std::vector<std::vector<int>> pyramid{
-      {0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
-  static const std::vector<std::vector<int>> hex{{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                                                 {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
-  return c.size == 4 ? tet : c.size == 5 ? pyramid : hex;
-}
-
 double tet6(const Vec& a, const Vec& b, const Vec& c, const Vec& d) {
   return (b - a).cross(c - a).dot(d - a);
 }
@@ -205,12 +196,12 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     out.clear();
     for (auto c : around) {
       const Cell& cell = cells[c];
-      for (const auto& f : faces_of(cell)) {
+      for (const auto& f : cell_faces(cell.size)) {
         bool touches = false;
-        for (int k : f) touches = touches || cell.v[k] == n;
+        for (int k = 0; k < f.size; ++k) touches = touches || cell.v[f.v[k]] == n;
         if (!touches) continue;
-        for (std::size_t k = 0; k < f.size(); ++k) {
-          const NodeId p = cell.v[f[k]], q = cell.v[f[(k + 1) % f.size()]];
+        for (int k = 0; k < f.size; ++k) {
+          const NodeId p = cell.v[f.v[k]], q = cell.v[f.v[(k + 1) % f.size]];
           if (p != n && q != n) out.push_back({std::min(p, q), std::max(p, q)});
         }
       }
@@ -294,9 +285,9 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
       for (auto c : around_b) {
         const Cell& cell = cells[c];
         if (!has(cell, a)) continue;
-        for (const auto& f : faces_of(cell))
-          for (std::size_t k = 0; k < f.size(); ++k) {
-            const NodeId p = cell.v[f[k]], q = cell.v[f[(k + 1) % f.size()]];
+        for (const auto& f : cell_faces(cell.size))
+          for (int k = 0; k < f.size; ++k) {
+            const NodeId p = cell.v[f.v[k]], q = cell.v[f.v[(k + 1) % f.size]];
             if (p != a && p != b && q != a && q != b)
               allowed_edges.push_back({std::min(p, q), std::max(p, q)});
           }

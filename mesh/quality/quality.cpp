@@ -11,46 +11,50 @@ namespace {
 using Vec = Eigen::Vector3d;
 constexpr double kDeg = 180.0 / std::numbers::pi;
 
-// Cell shapes in VTK order: outward faces, and for each corner three neighbours that form a
-// right-handed frame in a valid cell.
+// Cell shapes in VTK order: outward faces (the shared tables), and for each corner three
+// neighbours that form a right-handed frame in a valid cell.
 struct Shape {
-  std::vector<std::vector<int>> faces;
+  std::span<const CellFace> faces;
   std::vector<std::array<int, 4>> corners;  // vertex, then its three neighbours
   double jacobian_scale;                    // makes the ideal cell's corners 1
 };
 
-const Shape kTet{{{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}},
+const Shape kTet{kTetFaces,
                  {{{0, 1, 2, 3}}, {{1, 2, 0, 3}}, {{2, 0, 1, 3}}, {{3, 0, 2, 1}}},
                  std::numbers::sqrt2};
-const Shape kPyramid{{{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}},
+const Shape kPyramid{kPyramidFaces,
                      {{{0, 1, 3, 4}}, {{1, 2, 0, 4}}, {{2, 3, 1, 4}}, {{3, 0, 2, 4}}},
                      std::numbers::sqrt2};
-const Shape kHex{
-    {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}},
-    {{{0, 1, 3, 4}},
-     {{1, 2, 0, 5}},
-     {{2, 3, 1, 6}},
-     {{3, 0, 2, 7}},
-     {{4, 7, 5, 0}},
-     {{5, 4, 6, 1}},
-     {{6, 5, 7, 2}},
-     {{7, 6, 4, 3}}},
-    1.0};
+const Shape kHex{kHexFaces,
+                 {{{0, 1, 3, 4}},
+                  {{1, 2, 0, 5}},
+                  {{2, 3, 1, 6}},
+                  {{3, 0, 2, 7}},
+                  {{4, 7, 5, 0}},
+                  {{5, 4, 6, 1}},
+                  {{6, 5, 7, 2}},
+                  {{7, 6, 4, 3}}},
+                 1.0};
 
-Vec face_normal(const std::vector<int>& f, std::span<const Vec> x) {
-  if (f.size() == 3) return (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]);
-  return (x[f[2]] - x[f[0]]).cross(x[f[3]] - x[f[1]]);
+Vec face_normal(const CellFace& f, std::span<const Vec> x) {
+  const auto& v = f.v;
+  if (f.size == 3) return (x[v[1]] - x[v[0]]).cross(x[v[2]] - x[v[0]]);
+  return (x[v[2]] - x[v[0]]).cross(x[v[3]] - x[v[1]]);
+}
+
+bool has(const CellFace& f, int node) {
+  return std::find(f.v.begin(), f.v.begin() + f.size, node) != f.v.begin() + f.size;
 }
 
 CellQuality measure(const Shape& s, std::span<const Vec> x) {
   CellQuality q{};
   double shortest = INFINITY, longest = 0.0, skew = 0.0;
   for (const auto& f : s.faces) {
-    const std::size_t n = f.size();
+    const auto n = static_cast<std::size_t>(f.size);
     const double eq = n == 3 ? 60.0 : 90.0;
     double amax = 0.0, amin = 180.0;
     for (std::size_t c = 0; c < n; ++c) {
-      const Vec a = x[f[(c + n - 1) % n]] - x[f[c]], b = x[f[(c + 1) % n]] - x[f[c]];
+      const Vec a = x[f.v[(c + n - 1) % n]] - x[f.v[c]], b = x[f.v[(c + 1) % n]] - x[f.v[c]];
       const double len = b.norm();
       shortest = std::min(shortest, len);
       longest = std::max(longest, len);
@@ -70,7 +74,7 @@ CellQuality measure(const Shape& s, std::span<const Vec> x) {
   for (std::size_t f = 0; f < s.faces.size(); ++f)
     for (std::size_t g = f + 1; g < s.faces.size(); ++g) {
       int shared = 0;
-      for (int a : s.faces[f]) shared += std::count(s.faces[g].begin(), s.faces[g].end(), a) > 0;
+      for (int k = 0; k < s.faces[f].size; ++k) shared += has(s.faces[g], s.faces[f].v[k]);
       if (shared != 2) continue;
       const Vec n1 = face_normal(s.faces[f], x), n2 = face_normal(s.faces[g], x);
       const double d = n1.norm() * n2.norm();
