@@ -127,13 +127,13 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
   r.seconds.push_back({"mve", clock.seconds()});
 
   clock = Stopwatch();
-  auto quality = cell_quality(r.mesh);
-  r.before = summarize_quality(r.mesh, quality);
+  r.quality = cell_quality(r.mesh);
+  r.before = summarize_quality(r.mesh, r.quality);
   if (job.improve) {
     r.improvement = improve_mesh(r.mesh, volume.frame.spacing.minCoeff(), job.improve_options);
-    quality = cell_quality(r.mesh);
+    r.quality = cell_quality(r.mesh);
   }
-  r.after = summarize_quality(r.mesh, quality);
+  r.after = summarize_quality(r.mesh, r.quality);
   r.seconds.push_back({"quality", clock.seconds()});
   r.patches = patch_report(r.mesh);
   if (job.check) {
@@ -158,12 +158,11 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
   r.written.push_back(job.output.string());
   r.written.push_back(fs::path(job.output).replace_extension(".xdmf").string());
   if (job.write_vtu) {
-    const auto q = cell_quality(r.mesh);
     CellFields fields;
     for (Metric m : kMetrics) {
       auto& v = fields[metric_name(m)];
-      v.reserve(q.size());
-      for (const auto& c : q) v.push_back(c.get(m));
+      v.reserve(r.quality.size());
+      for (const auto& c : r.quality) v.push_back(c.get(m));
     }
     write_vtu(r.mesh, sibling("mesh.vtu"), fields);
     write_boundary_vtp(r.mesh, sibling("boundary.vtp"));

@@ -40,6 +40,7 @@ struct MeshJobResult {
   mve::MveStats mve;
   ImproveStats improvement;
   QualityReport before, after;
+  std::vector<CellQuality> quality;  // per cell of the final mesh, in its cell order
   std::vector<PatchReport> patches;
   std::optional<MeshCheck> check;
   std::vector<std::pair<std::string, double>> seconds;  // stage → wall time
