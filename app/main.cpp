@@ -16,9 +16,12 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "print nothing but errors")->configurable(false);
   app.parse_complete_callback(
       [&] { naris::set_verbosity(quiet ? naris::Verbosity::quiet : naris::Verbosity::normal); });
+  naris::app::add_phantom_command(app);
+  naris::app::add_interpolate_command(app);
   naris::app::add_segment_command(app);
   naris::app::add_mesh_command(app);
   naris::app::add_eog_command(app);
+  naris::app::add_run_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

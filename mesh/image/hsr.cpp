@@ -266,38 +266,81 @@ Image2D interpolate_linear(const Image2D& i1, const Image2D& i2, double s) {
 }
 
 namespace {
-// Signed distance to the mask's boundary (positive inside), brute force over boundary pixels.
-Image2D signed_distance(const Image2D& im) {
-  std::vector<std::pair<int, int>> edge;
-  auto inside = [&](int x, int y) { return im.at(x, y) > 0.5; };
-  for (int y = 0; y < im.height; ++y)
-    for (int x = 0; x < im.width; ++x) {
-      bool border = false;
-      for (auto [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-        const int xx = x + dx, yy = y + dy;
-        if (xx >= 0 && yy >= 0 && xx < im.width && yy < im.height && inside(xx, yy) != inside(x, y))
-          border = true;
-      }
-      if (border) edge.push_back({x, y});
+
+// Squared Euclidean distance transform along one line (Felzenszwalb & Huttenlocher 2012): the
+// lower envelope of parabolas rooted at the samples of f (0 on features, a large value elsewhere).
+void distance_1d(const double* f, int n, std::ptrdiff_t stride, double* out, std::vector<int>& v,
+                 std::vector<double>& z) {
+  v.assign(static_cast<std::size_t>(n), 0);
+  z.assign(static_cast<std::size_t>(n) + 1, 0.0);
+  int k = 0;
+  z[0] = -std::numeric_limits<double>::infinity();
+  z[1] = std::numeric_limits<double>::infinity();
+  auto fv = [&](int q) { return f[q * stride]; };
+  for (int q = 1; q < n; ++q) {
+    // z[0] = −∞ ends the loop: the parabola of v[0] is never removed from the left.
+    auto meet = [&](int p) {
+      return ((fv(q) + double(q) * q) - (fv(p) + double(p) * p)) / (2.0 * (q - p));
+    };
+    double s = meet(v[static_cast<std::size_t>(k)]);
+    while (s <= z[static_cast<std::size_t>(k)]) {
+      --k;
+      s = meet(v[static_cast<std::size_t>(k)]);
     }
-  Image2D out{im.width, im.height, std::vector<double>(im.v.size(), 0.0)};
-  for (int y = 0; y < im.height; ++y)
-    for (int x = 0; x < im.width; ++x) {
-      double best = std::numeric_limits<double>::infinity();
-      for (auto [ex, ey] : edge) best = std::min(best, std::hypot(x - ex, y - ey));
-      if (edge.empty()) best = std::max(im.width, im.height);
-      out.at(x, y) = inside(x, y) ? best : -best;
-    }
-  return out;
+    ++k;
+    v[static_cast<std::size_t>(k)] = q;
+    z[static_cast<std::size_t>(k)] = s;
+    z[static_cast<std::size_t>(k) + 1] = std::numeric_limits<double>::infinity();
+  }
+  k = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[static_cast<std::size_t>(k) + 1] < q) ++k;
+    const int p = v[static_cast<std::size_t>(k)];
+    out[q * stride] = double(q - p) * (q - p) + fv(p);
+  }
 }
+
+// Distance (pixels) from every pixel to the nearest pixel where `feature` holds.
+std::vector<double> distance_to(const Image2D& im, bool inside_feature) {
+  const int w = im.width, h = im.height;
+  const double far = 4.0 * (double(w) * w + double(h) * h) + 1.0;
+  std::vector<double> f(im.v.size()), g(im.v.size());
+  for (std::size_t k = 0; k < im.v.size(); ++k)
+    f[k] = (im.v[k] > 0.5) == inside_feature ? 0.0 : far;
+  std::vector<int> v;
+  std::vector<double> z, line(static_cast<std::size_t>(std::max(w, h)));
+  for (int x = 0; x < w; ++x) distance_1d(f.data() + x, h, w, g.data() + x, v, z);
+  for (int y = 0; y < h; ++y) {
+    distance_1d(g.data() + static_cast<std::ptrdiff_t>(y) * w, w, 1, line.data(), v, z);
+    for (int x = 0; x < w; ++x) f[static_cast<std::size_t>(y) * w + x] = std::sqrt(line[x]);
+  }
+  return f;
+}
+
 }  // namespace
 
-Image2D interpolate_shape(const Image2D& i1, const Image2D& i2, double s) {
-  const Image2D d1 = signed_distance(i1), d2 = signed_distance(i2);
-  Image2D out = i2;
+Image2D signed_distance(const Image2D& mask) {
+  // Half a pixel from each side puts the zero level on the boundary between the two sets.
+  const std::vector<double> to_out = distance_to(mask, false), to_in = distance_to(mask, true);
+  Image2D out{mask.width, mask.height, std::vector<double>(mask.v.size(), 0.0)};
+  const bool any_in = std::any_of(mask.v.begin(), mask.v.end(), [](double x) { return x > 0.5; });
+  const bool any_out = std::any_of(mask.v.begin(), mask.v.end(), [](double x) { return x <= 0.5; });
+  const double none = std::max(mask.width, mask.height);
+  for (std::size_t k = 0; k < out.v.size(); ++k)
+    out.v[k] =
+        mask.v[k] > 0.5 ? (any_out ? to_out[k] - 0.5 : none) : (any_in ? -(to_in[k] - 0.5) : -none);
+  return out;
+}
+
+Image2D interpolate_signed_distance(const Image2D& d1, const Image2D& d2, double s) {
+  Image2D out = d2;
   for (std::size_t k = 0; k < out.v.size(); ++k)
     out.v[k] = (1 - s) * d2.v[k] + s * d1.v[k] > 0.0 ? 1.0 : 0.0;
   return out;
+}
+
+Image2D interpolate_shape(const Image2D& i1, const Image2D& i2, double s) {
+  return interpolate_signed_distance(signed_distance(i1), signed_distance(i2), s);
 }
 
 }  // namespace naris

@@ -36,5 +36,9 @@ Image2D interpolate_hsr(const Image2D& i1, const Image2D& i2, const Displacement
 Image2D interpolate_linear(const Image2D& i1, const Image2D& i2, double s);
 // Shape-based: signed distance maps of the masks (value > 0.5) interpolated linearly.
 Image2D interpolate_shape(const Image2D& i1, const Image2D& i2, double s);
+// Signed Euclidean distance (pixels) to the boundary of a mask (value > 0.5), positive inside:
+// exact, linear time (separable transform). The shape-based blend of two such maps at s.
+Image2D signed_distance(const Image2D& mask);
+Image2D interpolate_signed_distance(const Image2D& d1, const Image2D& d2, double s);
 
 }  // namespace naris

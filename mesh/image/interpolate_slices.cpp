@@ -78,11 +78,16 @@ Volume<float> interpolate_slices(const Volume<float>& v, int axis, int k, SliceM
       // I2 is the lower slice (s = 0), I1 the upper (s = 1).
       Displacement d;
       if (method == SliceMethod::hsr && k > 0) d = register_hsr(b, a, hsr);
+      Image2D da, db;  // signed distance maps, once per pair
+      if (method == SliceMethod::shape && k > 0) {
+        da = signed_distance(a);
+        db = signed_distance(b);
+      }
       for (int q = 1; q <= k; ++q) {
         const double s = static_cast<double>(q) / (k + 1);
         Image2D im = method == SliceMethod::hsr      ? interpolate_hsr(b, a, d, s)
                      : method == SliceMethod::linear ? interpolate_linear(b, a, s)
-                                                     : interpolate_shape(b, a, s);
+                                                     : interpolate_signed_distance(db, da, s);
         if (mask && method != SliceMethod::shape)
           for (double& x : im.v) x = x > 0.5 ? 1.0 : 0.0;
         set_slice_across(out, axis, p * (k + 1) + q, im);

@@ -301,7 +301,7 @@ Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
   if (dims[0] < 2 || dims[1] < 2 || dims[2] < 2)
     fail(
         "{}: the image is {}×{}×{}; a volume needs at least two voxels along each axis "
-        "(a single slice cannot be meshed)",
+        "(a single slice is not a volume)",
         path.string(), dims[0], dims[1], dims[2]);
 
   Volume<float> volume;

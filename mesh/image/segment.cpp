@@ -1,15 +1,12 @@
 #include "image/segment.h"
 
 #include <fmt/format.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <regex>
 
 #include "core/error.h"
-#include "io/atomic_file.h"
 
 namespace naris {
 namespace {
@@ -192,38 +189,6 @@ ComponentSummary keep_largest_component(Volume<std::uint8_t>& mask) {
   summary.kept_voxels = best_size;
   summary.dropped_voxels = total - best_size;
   return summary;
-}
-
-void write_labelmap_nrrd(const Volume<std::uint8_t>& mask, const std::filesystem::path& path) {
-  const ImageFrame& f = mask.frame;
-  const Eigen::Matrix3d m = f.index_to_physical();
-  auto vec = [](const Eigen::Vector3d& v) {
-    return fmt::format("({:.17g},{:.17g},{:.17g})", v[0], v[1], v[2]);
-  };
-  const std::string header = fmt::format(
-      "NRRD0004\n# written by naris\ntype: uint8\ndimension: 3\nspace: left-posterior-superior\n"
-      "sizes: {} {} {}\nspace directions: {} {} {}\nkinds: domain domain domain\nencoding: gzip\n"
-      "space origin: {}\n\n",
-      f.dims[0], f.dims[1], f.dims[2], vec(m.col(0)), vec(m.col(1)), vec(m.col(2)), vec(f.origin));
-  std::string packed(compressBound(static_cast<uLong>(mask.values.size())) + 64, '\0');
-  z_stream z{};
-  if (deflateInit2(&z, 1, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY) != Z_OK)
-    fail("{}: cannot start compression", path.string());
-  z.next_in = const_cast<Bytef*>(mask.values.data());
-  z.avail_in = static_cast<uInt>(mask.values.size());
-  z.next_out = reinterpret_cast<Bytef*>(packed.data());
-  z.avail_out = static_cast<uInt>(packed.size());
-  const int rc = deflate(&z, Z_FINISH);
-  packed.resize(z.total_out);
-  deflateEnd(&z);
-  if (rc != Z_STREAM_END) fail("{}: compression failed", path.string());
-  AtomicOutput out(path);
-  {
-    std::ofstream file(out.temp_path(), std::ios::binary);
-    file << header << packed;
-    if (!file) fail("{}: write failed (disk full?)", path.string());
-  }
-  out.commit();
 }
 
 }  // namespace naris

@@ -1,10 +1,10 @@
 #pragma once
 // Segmentation of the airway from CT (dissertation 4.2.2): a threshold from the HU histogram,
 // 26-connected region growing from seed voxels, keep-largest-component, and the labelmap
-// written as NRRD for 3D Slicer. Memory is one byte per voxel beyond the image.
+// written as NRRD (image/write_volume.h) for 3D Slicer. Memory is one byte per voxel beyond the
+// image.
 #include <array>
 #include <cstdint>
-#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -37,8 +37,5 @@ struct ComponentSummary {
 };
 // Keeps only the largest 26-connected component of a 0/1 mask.
 ComponentSummary keep_largest_component(Volume<std::uint8_t>& mask);
-
-// A gzip-compressed NRRD labelmap with the image's frame (3D Slicer opens it as a segmentation).
-void write_labelmap_nrrd(const Volume<std::uint8_t>& mask, const std::filesystem::path& path);
 
 }  // namespace naris

@@ -327,4 +327,117 @@ TEST_F(CliSegment, BadSeedsAndThresholdsAreClearErrors) {
                        "neither a number");
 }
 
+TEST_F(CliSegment, InterpolatesGrayValuesAndMasks) {
+  const fs::path in = ct();
+  const fs::path fine = dir_ / "out" / "fine.nrrd";
+  CliRun r = naris("interpolate " + in.string() + " --axis k --insert 2 -o " + fine.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("24×24×24 → 24×24×70"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("gray values"), std::string::npos) << r.err;
+  // Shape-based interpolation of gray values segments them first and writes a labelmap, which
+  // `segment` then grows from the seed as it is.
+  const fs::path shape = dir_ / "out" / "shape.nrrd";
+  r = naris("interpolate " + in.string() + " --method shape --axis k --insert 1 -o " +
+            shape.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("segmented below"), std::string::npos) << r.err;
+  r = naris("segment " + shape.string() + " --seed 10,10,20 -o " +
+            (dir_ / "out" / "a.nrrd").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  // The air box spans k 4..19 of the acquired slices: 2·15 + 1 interpolated slices of 13·9.
+  EXPECT_NE(r.err.find("airway " + std::to_string(13 * 9 * 31) + " voxels"), std::string::npos)
+      << r.err;
+}
+
+TEST_F(Cli, InterpolateBadInput) {
+  const fs::path one = nrrd("one.nrrd", "float", "12 12 1", payload(std::vector<float>(144)));
+  const std::string o = " -o " + (dir_ / "out" / "x.nrrd").string();
+  expect_clean_failure(naris("interpolate " + one.string() + o), "single slice");
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  expect_clean_failure(naris("interpolate " + in.string() + " --method cubic" + o), "method");
+  expect_clean_failure(naris("interpolate " + in.string() + " --insert 2 --spacing 0.5" + o),
+                       "excludes");
+}
+
+TEST_F(Cli, PhantomBadInput) {
+  const std::string o = " -o " + (dir_ / "out" / "ct.nrrd").string();
+  expect_clean_failure(naris("phantom --subject 0" + o), "subject");
+  expect_clean_failure(naris("phantom --slice -3" + o), "slice");
+}
+
+class CliRunCase : public Cli {
+ protected:
+  fs::path write_case(const std::string& text) {
+    const fs::path p = dir_ / "in" / "case.yaml";
+    std::ofstream(p) << text;
+    return p;
+  }
+  // A coarse phantom case (1 mm pixels) that runs in a few seconds.
+  std::string coarse_case() const {
+    return "output: " + (dir_ / "out").string() +
+           "\nphantom: {subject: 2, pixel: 1.0, slice: 3.0}\n"
+           "interpolate: {method: hsr, spacing: 1.0, block: 4, levels: 3}\n"
+           "segment: {seeds: [\"-9,0,8 mm\"]}\n"
+           "mesh: {inlet: \"p=0,0,0;n=0,1,0\", outlet: \"p=0,96,0;n=0,1,0\"}\n";
+  }
+};
+
+TEST_F(CliRunCase, RunsEveryStageThenSkipsThoseUpToDate) {
+  const fs::path c = write_case(coarse_case());
+  CliRun r = naris("run " + c.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f : {"ct.nrrd", "exact.nrrd", "interpolated.nrrd", "airway.nrrd", "mesh/mesh.h5",
+                        "mesh/mesh.vtu", "mesh/mesh.json"})
+    EXPECT_TRUE(fs::exists(dir_ / "out" / f)) << f;
+  EXPECT_NE(r.err.find("patch     inlet"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("patch     outlet"), std::string::npos) << r.err;
+  const std::regex dice_line("Dice (0\\.[0-9]+)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, dice_line)) << r.err;
+  EXPECT_GT(std::stod(m[1]), 0.8);  // at 1 mm voxels the thin meatuses lose their edges
+  r = naris("run " + c.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* stage : {"phantom", "interpolate", "segment", "mesh"})
+    EXPECT_NE(r.err.find(std::string(stage) + ": up to date, skipped"), std::string::npos)
+        << stage << "\n"
+        << r.err;
+  // Changing the segmentation reruns it and what follows, not what comes before.
+  std::string text = coarse_case();
+  text.replace(text.find("segment: {"), 10, "segment: {threshold: -400, ");
+  write_case(text);
+  r = naris("run " + c.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("interpolate: up to date, skipped"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("] segment\n"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("] mesh\n"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("threshold -400.0 HU (given)"), std::string::npos) << r.err;
+}
+
+TEST_F(CliRunCase, BadCaseFilesAreClearErrors) {
+  const std::string out = "output: " + (dir_ / "out").string() + "\n";
+  const std::string mesh = "mesh: {}\n";
+  expect_clean_failure(naris("run " + (dir_ / "in" / "absent.yaml").string()), "no such case");
+  expect_clean_failure(naris("run " + write_case(out + "phantom: [1, 2\n").string()),
+                       "not valid YAML");
+  expect_clean_failure(
+      naris("run " + write_case(out + "phantom: {}\nsolver: {}\n" + mesh).string()),
+      "unknown setting 'solver'");
+  expect_clean_failure(naris("run " + write_case(out + "phantom: {subjekt: 2}\n" + mesh).string()),
+                       "unknown setting 'subjekt'");
+  expect_clean_failure(
+      naris("run " + write_case(out + "phantom: {subject: two}\n" + mesh).string()),
+      "not a valid value");
+  expect_clean_failure(
+      naris("run " + write_case(out + "input: ct.nrrd\nphantom: {}\n" + mesh).string()),
+      "either 'input'");
+  expect_clean_failure(naris("run " + write_case(out + "phantom: {}\n").string()),
+                       "no 'mesh' section");
+  expect_clean_failure(naris("run " + write_case(out + "input: absent.nrrd\n" + mesh).string()),
+                       "does not exist");
+  expect_clean_failure(
+      naris("run " +
+            write_case(out + "phantom: {}\ninterpolate: {method: cubic}\n" + mesh).string()),
+      "unknown interpolation method");
+}
+
 }  // namespace

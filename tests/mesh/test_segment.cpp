@@ -9,6 +9,7 @@
 #include "image/read_volume.h"
 #include "image/resample.h"
 #include "image/segment.h"
+#include "image/write_volume.h"
 
 namespace naris {
 namespace {
