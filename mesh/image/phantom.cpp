@@ -36,8 +36,8 @@ constexpr Keyframe kKeyframes[] = {
     {22.0, 3.5, 3.0, 30.0, 1.9, 0.0, {0, 0, 0}, {0, 0, 0}, 1.0},
     {33.5, 3.0, 2.5, 33.6, 2.2, 0.0, {0, 0, 0}, {0, 0, 0}, 1.0},
     {44.0, 3.0, 2.5, 35.0, 1.7, 3.0, {8.0, 7.0, 3.5}, {5.0, 5.0, 2.0}, 1.3},
-    {54.5, 3.0, 2.5, 36.0, 1.4, 6.0, {10.0, 8.0, 5.0}, {7.0, 7.0, 4.0}, 1.25},
-    {65.0, 3.0, 2.5, 36.5, 1.45, 6.0, {10.0, 8.0, 5.0}, {6.0, 5.5, 4.0}, 1.35},
+    {54.5, 3.0, 2.5, 36.0, 1.45, 6.0, {11.0, 9.0, 5.5}, {6.0, 6.0, 4.0}, 1.35},
+    {65.0, 3.0, 2.5, 36.5, 1.5, 6.0, {10.0, 8.0, 5.0}, {6.0, 5.5, 4.0}, 1.4},
     {75.5, 3.0, 2.5, 37.0, 2.0, 4.0, {8.0, 6.0, 3.0}, {5.0, 4.0, 2.0}, 1.35},
     {85.0, 3.5, 3.0, 38.2, 2.8, 0.0, {0, 0, 0}, {0, 0, 0}, 1.3},
     {96.0, 5.0, 10.0, 26.0, 6.0, 0.0, {0, 0, 0}, {0, 0, 0}, 1.3},
@@ -141,6 +141,7 @@ Section make_section(const Keyframe& k, const double (&branch_scale)[3], double 
   }
   if (k.olf > 0.0)
     sec.capsules[sec.count++] = {k.uc, k.ht, k.uc, k.ht + k.olf + k.rc, kOlfactoryRadius};
+  double below_top = 0.0;  // the highest air of the branch below
   for (int b = 0; b < 3; ++b) {
     const double len = k.len[b] * branch_scale[b];
     if (len <= 0.05) continue;
@@ -155,7 +156,12 @@ Section make_section(const Keyframe& k, const double (&branch_scale)[3], double 
     rm = std::min(rm, 0.5 * len + 0.2);
     const double h = k.hb + kBranchAttach[b] * (k.ht - k.hb);
     const double ue = k.uc + len, he = h + 0.2 * len;
-    const double drop = k.drop[b] * branch_scale[b];
+    double drop = k.drop[b] * branch_scale[b];
+    // The meatus runs down the lateral wall but stops 2 mm of tissue short of the branch below
+    // (the inferior one at the floor): a turbinate stays attached to the lateral wall, never an
+    // island.
+    drop = std::min(drop, he - rm - (b == 0 ? k.hb - k.rc : below_top + 2.0));
+    below_top = he + rm;
     sec.capsules[sec.count++] = {k.uc, h, ue, he, rm};
     if (drop > 0.05) sec.capsules[sec.count++] = {ue, he, ue + 0.3 * drop, he - drop, rm};
   }

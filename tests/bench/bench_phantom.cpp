@@ -18,6 +18,7 @@ using namespace naris;
 int main(int argc, char** argv) {
   const int subjects = argc > 1 ? std::atoi(argv[1]) : 3;
   set_verbosity(Verbosity::quiet);
+  std::printf("CT 0.3×0.3×3 mm → 0.3 mm isotropic; Dice against the exact airway on that grid\n");
   std::printf("%-7s %-7s %8s %9s %10s %9s %8s %8s %8s\n", "subject", "method", "CT s", "interp s",
               "threshold", "segment s", "Dice", "air mL", "exact mL");
   for (int subject = 1; subject <= subjects; ++subject) {
