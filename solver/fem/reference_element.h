@@ -49,6 +49,7 @@ struct MappedValues {
   Eigen::Matrix<double, Nodes, 1> value;
   Eigen::Matrix<double, Nodes, 3> gradient;  // ∂N_i/∂x_j, physical
   double det_jacobian = 0.0;
+  Eigen::Matrix3d inverse_jacobian;  // ∂ξ_k/∂x_j
 };
 
 // Values and physical gradients at reference point ξ of a cell with node coordinates X (one
@@ -60,8 +61,9 @@ MappedValues<Element::nodes> map_to_cell(const Eigen::Matrix<double, Element::no
   m.value = s.value;
   const Eigen::Matrix3d J = X.transpose() * s.gradient;  // J(j, k) = Σ_i X_ij ∂N_i/∂ξ_k
   m.det_jacobian = J.determinant();
+  m.inverse_jacobian = J.inverse();
   // ∇_x N = J^{-T} ∇_ξ N, as rows: gradient = ∇_ξ N · J^{-1}.
-  m.gradient = s.gradient * J.inverse();
+  m.gradient = s.gradient * m.inverse_jacobian;
   return m;
 }
 

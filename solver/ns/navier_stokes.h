@@ -1,0 +1,51 @@
+#pragma once
+// Steady incompressible Navier–Stokes on a hybrid mesh by Picard iteration on the stabilized
+// Oseen problem (oseen_element.h), assembled into one PETSc matrix with 4×4 blocks per node
+// pair (preallocated from the node graph) and solved with a PETSc KSP (options prefix "ns_";
+// by default a direct LU through MUMPS). Convergence is judged on the full nonlinear residual.
+#include <Eigen/Dense>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hybrid_mesh.h"
+
+namespace naris::ns {
+
+using BodyForce = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
+
+struct FlowField {
+  std::vector<Eigen::Vector3d> velocity;  // per node
+  std::vector<double> pressure;           // per node
+};
+
+// Velocity fixed at some nodes (no-slip walls, inlets, exact data in tests) and optionally the
+// pressure at one node (when no boundary sets its level).
+struct DirichletConditions {
+  std::vector<NodeId> nodes;
+  std::vector<Eigen::Vector3d> values;
+  std::optional<std::pair<NodeId, double>> pressure_pin;
+};
+
+struct PicardOptions {
+  int max_iterations = 100;
+  double tolerance = 1e-8;  // on the residual 2-norm relative to that of the load (F with data)
+  double absolute_tolerance = 1e-13;
+  double relaxation = 1.0;  // U ← U + ω (U* − U)
+  std::string options_prefix = "ns_";
+};
+
+struct PicardReport {
+  std::vector<double> residuals;  // nonlinear residual 2-norm before each solve, and the last
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Solves with viscosity ν (1/Re in nondimensional form) and body force f (may be empty).
+// `initial` (optional) warm-starts; otherwise the first iterate is the Stokes solution.
+FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce& force,
+                              const DirichletConditions& conditions, const PicardOptions& options,
+                              PicardReport* report = nullptr, const FlowField* initial = nullptr);
+
+}  // namespace naris::ns

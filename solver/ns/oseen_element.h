@@ -1,0 +1,128 @@
+#pragma once
+// The element matrix of the stabilized Oseen problem — the Picard linearization of the steady
+// incompressible Navier–Stokes equations (eq. 4.6–4.7) about an advection field a — for
+// equal-order velocity and pressure on any of the three cell types:
+//
+//   ν(∇u, ∇w) + ((a·∇)u, w) − (p, ∇·w) + (∇·u, q)                          Galerkin
+//   + Σ_K τ_M ((a·∇)u + ∇p − f, (a·∇)w + ∇q)                               SUPG + PSPG
+//   + Σ_K τ_C (∇·u, ∇·w)                                                   grad-div (LSIC)
+//   = (f, w)
+//
+// with τ_M = (3 / (a·G a + ν² G:G))^(1/2) and τ_C = 3/(τ_M tr G), G the element metric
+// (Shakib, Hughes & Johan 1991; Whiting & Jansen 2001); on a cube of side L these are
+// Tezduyar's ((2|a|/h)² + 9(4ν/h²)²)^(−1/2) and h²/(12 τ_M) with h its diameter √3 L. Linear
+// elements cannot represent the viscous term νΔu of the residual (it vanishes on tets); dropping it
+// makes the stabilization inconsistent and costs the pressure its order. Following Jansen, Collis,
+// Whiting & Shakib (1999) it is reconstructed from a recovered nodal gradient of the advection
+// field (lagged with the Picard iterate, so it enters as a known force): f_stab = f + ν ∇·(Σ N_j
+// G_j). The Laplacian form of the viscous term makes the natural condition ν ∂u/∂n − p n = 0
+// ("do-nothing", traction-free for fully developed outflow). With a = u the element residual
+// K(u)u − F(u) is the discrete Navier–Stokes residual.
+//
+// Degrees of freedom are interleaved per node: (u, v, w, p) of node 0, then node 1, …
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "fem/quadrature.h"
+#include "fem/reference_element.h"
+
+namespace naris::ns {
+
+template <int Nodes>
+struct ElementSystem {
+  Eigen::Matrix<double, 4 * Nodes, 4 * Nodes> K;
+  Eigen::Matrix<double, 4 * Nodes, 1> F;
+};
+
+// The metric of the reference cell: identity for the pyramid and the hexahedron (side 2); for
+// the tetrahedron the matrix [2 1 1; 1 2 1; 1 1 2] that makes the metric independent of which
+// vertex is the reference's origin (the unit right tetrahedron seen as an equilateral one, as
+// in PHASTA), times 2 — the factor that balances velocity and pressure accuracy at ν = 1 and
+// ν = 0.01 on the convergence study (bench_ns_convergence; 1 under-stabilizes the pressure at
+// ν = 1, 4 over-diffuses at ν = 0.01).
+template <class E>
+Eigen::Matrix3d reference_metric() {
+  if constexpr (E::type == fem::CellType::tet4) {
+    return (Eigen::Matrix3d() << 4, 2, 2, 2, 4, 2, 2, 2, 4).finished();
+  } else {
+    return Eigen::Matrix3d::Identity();
+  }
+}
+
+// The quadrature degree for each cell type: 2 is exact for the affine tet's terms; the pyramid
+// and the hexahedron use 2×2×2-type rules (3 points across the pyramid's collapsed axis).
+inline constexpr int kOseenQuadratureDegree = 2;
+
+// The reference shape values at the quadrature points of one cell type, computed once.
+template <class E>
+struct ShapeTable {
+  std::vector<fem::QuadraturePoint> points;
+  std::vector<fem::ShapeValues<E::nodes>> shapes;
+  static const ShapeTable& get() {
+    static const ShapeTable table = [] {
+      ShapeTable t;
+      for (const auto& q : fem::quadrature(E::type, kOseenQuadratureDegree)) {
+        t.points.push_back(q);
+        t.shapes.push_back(E::shape(q.xi));
+      }
+      return t;
+    }();
+    return table;
+  }
+};
+
+// X: node coordinates, a: advection velocity at the nodes (both one row per node); grad: the
+// recovered nodal gradient of a, row j = G_j row-major (∂a_c/∂x_d at 3c + d), or null;
+// force(x) → f (Eigen::Vector3d) at a physical point.
+template <class E, class Force>
+void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
+                   const Eigen::Matrix<double, E::nodes, 3>& a,
+                   const Eigen::Matrix<double, E::nodes, 9>* grad, double nu, const Force& force,
+                   ElementSystem<E::nodes>& out) {
+  constexpr int N = E::nodes;
+  const ShapeTable<E>& table = ShapeTable<E>::get();
+  const std::size_t nq = table.points.size();
+  std::array<fem::MappedValues<N>, 27> mapped;
+  for (std::size_t q = 0; q < nq; ++q) mapped[q] = fem::map_to_cell<E>(X, table.shapes[q]);
+  out.K.setZero();
+  out.F.setZero();
+  for (std::size_t q = 0; q < nq; ++q) {
+    const auto& m = mapped[q];
+    const double w = table.points[q].weight * m.det_jacobian;
+    const Eigen::Matrix<double, N, 1>& Nv = m.value;
+    const Eigen::Matrix<double, N, 3>& G = m.gradient;
+    const Eigen::Vector3d aq = a.transpose() * Nv;
+    const Eigen::Vector3d f = force(Eigen::Vector3d(X.transpose() * Nv));
+    Eigen::Vector3d f_stab = f;
+    if (grad)
+      for (int c = 0; c < 3; ++c)
+        for (int d = 0; d < 3; ++d) f_stab[c] += nu * G.col(d).dot(grad->col(3 * c + d));
+    // The element metric G = J^{-T} J^{-1}, on references of side 2 (the tet's, of side 1, is
+    // scaled to match): it measures the cell along every direction, so a flat cell gets the
+    // small τ of its thin direction.
+    const Eigen::Matrix3d metric =
+        m.inverse_jacobian.transpose() * reference_metric<E>() * m.inverse_jacobian;
+    const double tau_m = std::sqrt(3.0 / (aq.dot(metric * aq) + nu * nu * metric.squaredNorm()));
+    const double tau_c = 3.0 / (tau_m * metric.trace());
+    const Eigen::Matrix<double, N, 1> adv = G * aq;  // (a·∇)N_i
+    const Eigen::Matrix<double, N, N> diffusion = G * G.transpose();
+    for (int i = 0; i < N; ++i) {
+      const double supg_i = tau_m * adv[i];
+      for (int j = 0; j < N; ++j) {
+        const double momentum = w * (nu * diffusion(i, j) + Nv[i] * adv[j] + supg_i * adv[j]);
+        for (int c = 0; c < 3; ++c) {
+          out.K(4 * i + c, 4 * j + c) += momentum;
+          for (int d = 0; d < 3; ++d) out.K(4 * i + c, 4 * j + d) += w * tau_c * G(i, c) * G(j, d);
+          out.K(4 * i + c, 4 * j + 3) += w * (-G(i, c) * Nv[j] + supg_i * G(j, c));
+          out.K(4 * i + 3, 4 * j + c) += w * (Nv[i] * G(j, c) + tau_m * G(i, c) * adv[j]);
+        }
+        out.K(4 * i + 3, 4 * j + 3) += w * tau_m * diffusion(i, j);
+      }
+      for (int c = 0; c < 3; ++c) out.F[4 * i + c] += w * (Nv[i] * f[c] + supg_i * f_stab[c]);
+      out.F[4 * i + 3] += w * tau_m * G.row(i).dot(f_stab);
+    }
+  }
+}
+
+}  // namespace naris::ns

@@ -1,0 +1,136 @@
+// The stabilized equal-order Navier–Stokes discretization against exact solutions
+// (VERIFICATION.md §2): the Couette patch test at round-off on tet-only, hex-only and MVE
+// hybrid meshes, and the steady Ethier–Steinman (Beltrami) flow converging at the expected
+// orders at ν = 1 and ν = 0.01.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <numbers>
+
+#include "fem/quadrature.h"
+#include "fem/reference_element.h"
+#include "manufactured.h"
+#include "meshes.h"
+#include "ns/navier_stokes.h"
+#include "parallel/petsc.h"
+
+namespace naris::ns {
+namespace {
+
+using testing::beltrami;
+using testing::beltrami_pressure;
+using testing::Errors;
+using testing::Exact;
+using testing::exact_on_boundary;
+using testing::ExactScalar;
+using testing::l2_errors;
+constexpr double kD = testing::kBeltramiD;
+
+class PetscEnvironment : public ::testing::Environment {
+ public:
+  void SetUp() override { session_ = std::make_unique<petsc::Session>(); }
+  void TearDown() override { session_.reset(); }
+
+ private:
+  std::unique_ptr<petsc::Session> session_;
+};
+[[maybe_unused]] const auto* const kPetsc =
+    ::testing::AddGlobalTestEnvironment(new PetscEnvironment);
+
+// Inside a ball of radius 0.9 (its surface cuts the grid anywhere: hexes, pyramids, tets).
+double ball(const Eigen::Vector3d& x) {
+  return 0.9 - (x - Eigen::Vector3d(0.013, -0.021, 0.017)).norm();
+}
+
+TEST(NavierStokes, CouettePatchTestIsExactOnEveryCellType) {
+  const double gamma = 1.7;
+  const Exact u = [&](const Eigen::Vector3d& x) { return Eigen::Vector3d(gamma * x[1], 0, 0); };
+  const ExactScalar p = [](const Eigen::Vector3d&) { return 0.25; };
+  const std::pair<const char*, HybridMesh> meshes[] = {
+      {"hex", testing::box_hex(4)},
+      {"tet", testing::box_tet(4)},
+      {"mve ball", testing::mve_mesh(ball, -1.0, 1.0, 0.25)}};
+  for (const auto& [name, mesh] : meshes) {
+    if (std::string(name) == "mve ball") {
+      EXPECT_GT(mesh.pyramids.size(), 0u);
+      EXPECT_GT(mesh.hexes.size(), 0u);
+      EXPECT_GT(mesh.tets.size(), 0u);
+    }
+    for (const double nu : {1.0, 0.01}) {
+      // A direct solve, so that round-off is the only error left.
+      PetscOptionsSetValue(nullptr, "-patch_ksp_type", "preonly");
+      PetscOptionsSetValue(nullptr, "-patch_pc_type", "lu");
+      PicardOptions options;
+      options.options_prefix = "patch_";
+      PicardReport report;
+      const FlowField f =
+          solve_navier_stokes(mesh, nu, {}, exact_on_boundary(mesh, u, p), options, &report);
+      double eu = 0, ep = 0;
+      for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+        eu = std::max(eu, (f.velocity[n] - u(mesh.nodes[n])).norm());
+        ep = std::max(ep, std::abs(f.pressure[n] - 0.25));
+      }
+      std::printf("[ info ] Couette on %s, nu %g: max error u %.2e, p %.2e, %d Picard steps\n",
+                  name, nu, eu, ep, report.iterations);
+      EXPECT_LT(eu, 1e-11) << name << " nu " << nu;
+      EXPECT_LT(ep, 1e-10) << name << " nu " << nu;
+      EXPECT_TRUE(report.converged);
+    }
+  }
+}
+
+struct Rates {
+  std::vector<double> h, eu, ep;
+};
+
+Rates ethier_steinman(const std::string& kind, const std::vector<int>& sizes, double nu) {
+  Rates r;
+  const BodyForce force = [nu](const Eigen::Vector3d& x) -> Eigen::Vector3d {
+    return nu * kD * kD * beltrami(x);
+  };
+  for (int n : sizes) {
+    const HybridMesh mesh = testing::convergence_mesh(kind, n);
+    PicardOptions options;
+    options.tolerance = 1e-9;
+    PicardReport report;
+    const FlowField f = solve_navier_stokes(
+        mesh, nu, force, exact_on_boundary(mesh, beltrami, beltrami_pressure), options, &report);
+    EXPECT_TRUE(report.converged) << kind << " n " << n;
+    const Errors e = l2_errors(mesh, f, beltrami, beltrami_pressure);
+    r.h.push_back(2.0 / n);
+    r.eu.push_back(e.velocity);
+    r.ep.push_back(e.pressure);
+    std::printf(
+        "[ info ] Ethier-Steinman %s nu %g h %.4f: %zu cells, %d Picard steps, L2 u %.3e, p %.3e",
+        kind.c_str(), nu, 2.0 / n, mesh.cell_count(), report.iterations, e.velocity, e.pressure);
+    if (r.h.size() > 1) {
+      const std::size_t k = r.h.size() - 1;
+      const double s = std::log(r.h[k - 1] / r.h[k]);
+      std::printf("  rates u %.2f, p %.2f", std::log(r.eu[k - 1] / r.eu[k]) / s,
+                  std::log(r.ep[k - 1] / r.ep[k]) / s);
+    }
+    std::printf("\n");
+  }
+  return r;
+}
+
+// Over the last two refinements: velocity ≈ h², pressure at least h (VERIFICATION.md §2).
+void expect_orders(const Rates& r, const std::string& what) {
+  const std::size_t k = r.h.size() - 1;
+  const double s = std::log(r.h[k - 1] / r.h[k]);
+  EXPECT_GT(std::log(r.eu[k - 1] / r.eu[k]) / s, 1.8) << what;
+  EXPECT_GT(std::log(r.ep[k - 1] / r.ep[k]) / s, 1.0) << what;
+}
+
+TEST(NavierStokes, EthierSteinmanConvergesAtSecondOrderInVelocity) {
+  for (const double nu : {1.0, 0.01})
+    for (const char* kind : {"hex", "tet", "mve-box", "mve-ball"})
+      expect_orders(ethier_steinman(kind, {4, 8, 16}, nu),
+                    std::string(kind) + " nu " + std::to_string(nu));
+}
+
+}  // namespace
+}  // namespace naris::ns
