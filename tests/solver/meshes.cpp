@@ -9,13 +9,13 @@ namespace {
 
 class LambdaField : public mve::FieldSource {
  public:
-  LambdaField(const std::function<double(const Eigen::Vector3d&)>& f, double lo, double hi,
-              double h)
+  LambdaField(const std::function<double(const Eigen::Vector3d&)>& f, const Eigen::Vector3d& lo,
+              const Eigen::Vector3d& hi, double h)
       : f_(f) {
-    const int n = static_cast<int>(std::lround((hi - lo) / h)) + 1;
-    frame_.dims = {n, n, n};
+    for (int a = 0; a < 3; ++a)
+      frame_.dims[a] = static_cast<int>(std::lround((hi[a] - lo[a]) / h)) + 1;
     frame_.spacing = Eigen::Vector3d::Constant(h);
-    frame_.origin = Eigen::Vector3d::Constant(lo);
+    frame_.origin = lo;
   }
   const ImageFrame& frame() const override { return frame_; }
   void read_slice(int k, std::span<float> out) const override {
@@ -107,8 +107,14 @@ HybridMesh box_tet(int n) {
 
 HybridMesh mve_mesh(const std::function<double(const Eigen::Vector3d&)>& inside, double lo,
                     double hi, double h) {
+  return mve_mesh_box(inside, Eigen::Vector3d::Constant(lo), Eigen::Vector3d::Constant(hi), h,
+                      mve::MveOptions{});
+}
+
+HybridMesh mve_mesh_box(const std::function<double(const Eigen::Vector3d&)>& inside,
+                        const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double h,
+                        const mve::MveOptions& options) {
   const LambdaField field(inside, lo, hi, h);
-  mve::MveOptions options;
   return mve::march_volume_elements(field, options);
 }
 

@@ -15,6 +15,10 @@ HybridMesh box_tet(int n);
 // The MVE mesh of {x : inside(x) > 0} sampled on a grid of spacing h over [lo, hi]³.
 HybridMesh mve_mesh(const std::function<double(const Eigen::Vector3d&)>& inside, double lo,
                     double hi, double h);
+// The MVE mesh of {x : inside(x) > 0} on a grid of spacing h over the box [lo, hi].
+HybridMesh mve_mesh_box(const std::function<double(const Eigen::Vector3d&)>& inside,
+                        const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double h,
+                        const mve::MveOptions& options);
 // The meshes of the convergence study at n cells across [−1,1]: "hex", "tet", "mve-box" (a box
 // whose faces cut the grid off its nodes) or "mve-ball" (a ball of radius 0.95).
 HybridMesh convergence_mesh(const std::string& kind, int n);

@@ -1,0 +1,102 @@
+// Hagen–Poiseuille flow in a straight pipe meshed by MVE from a sampled cylinder, 20 voxels
+// across, with the fully developed inlet profile, no slip on the wall and the traction-free
+// outlet: the pressure gradient in the developed region against 8πνQ/A² and the centreline
+// speed against twice the mean (VERIFICATION.md §2), at a low Reynolds number and at 610;
+// inlet and outlet fluxes agree.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "core/error.h"
+#include "meshes.h"
+#include "ns/boundary_conditions.h"
+#include "ns/navier_stokes.h"
+
+namespace naris::ns {
+namespace {
+
+// D = 1 along z from 0 to `length`, h = D/20; the pipe leaves the grid through k = min (inlet)
+// and k = max (outlet).
+HybridMesh pipe(double length) {
+  const double h = 1.0 / 20.0;
+  mve::MveOptions options;
+  options.side_patch[4] = "inlet";
+  options.side_patch[5] = "outlet";
+  return testing::mve_mesh_box(
+      [](const Eigen::Vector3d& x) { return 0.5 - std::hypot(x[0] - 0.013, x[1] + 0.007); },
+      {-0.6, -0.6, 0.0}, {0.6, 0.6, length}, h, options);
+}
+
+// Flux through the patch: Σ over its faces of ∫ u·n dA (outward normal).
+double patch_flux(const HybridMesh& mesh, const FlowField& f, const std::string& name) {
+  const int id = mesh.patch_id(name);
+  double flux = 0.0;
+  auto tri = [&](NodeId a, NodeId b, NodeId c) {
+    const Eigen::Vector3d an =
+        0.5 * (mesh.nodes[b] - mesh.nodes[a]).cross(mesh.nodes[c] - mesh.nodes[a]);
+    flux += an.dot(f.velocity[a] + f.velocity[b] + f.velocity[c]) / 3.0;
+  };
+  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t)
+    if (mesh.boundary_tri_patch[t] == id)
+      tri(mesh.boundary_tris[t][0], mesh.boundary_tris[t][1], mesh.boundary_tris[t][2]);
+  // Planar quads: the bilinear field's flux is the area times the mean of its corners.
+  for (std::size_t q = 0; q < mesh.boundary_quads.size(); ++q)
+    if (mesh.boundary_quad_patch[q] == id) {
+      const auto& v = mesh.boundary_quads[q];
+      const Eigen::Vector3d an =
+          0.5 * (mesh.nodes[v[2]] - mesh.nodes[v[0]]).cross(mesh.nodes[v[3]] - mesh.nodes[v[1]]);
+      flux +=
+          an.dot(f.velocity[v[0]] + f.velocity[v[1]] + f.velocity[v[2]] + f.velocity[v[3]]) / 4.0;
+    }
+  return flux;
+}
+
+void check_poiseuille(double re) {
+  const double length = 4.0, nu = 1.0 / re;
+  const HybridMesh mesh = pipe(length);
+  InletSummary inlet;
+  const DirichletConditions bc = airflow_conditions(mesh, InletProfile::developed, 1.0, &inlet);
+  PicardReport report;
+  const FlowField f = solve_navier_stokes(mesh, nu, {}, bc, {}, &report);
+  ASSERT_TRUE(report.converged) << "Re " << re;
+  const double q = inlet.flux, area = inlet.area;
+  // Pressure gradient: least squares p = p0 + G z over the nodes of the middle half.
+  double sz = 0, sp = 0, szz = 0, szp = 0, n = 0, centre = 0, centre_n = 0;
+  for (std::size_t k = 0; k < mesh.nodes.size(); ++k) {
+    const Eigen::Vector3d& x = mesh.nodes[k];
+    if (x[2] < 1.0 || x[2] > 3.0) continue;
+    sz += x[2], sp += f.pressure[k], szz += x[2] * x[2], szp += x[2] * f.pressure[k], ++n;
+    if (std::hypot(x[0] - 0.013, x[1] + 0.007) < 0.04) centre += f.velocity[k][2], ++centre_n;
+  }
+  const double gradient = -(n * szp - sz * sp) / (n * szz - sz * sz);
+  const double hagen_poiseuille = 8.0 * std::numbers::pi * nu * q / (area * area);
+  const double u_max = centre / centre_n, u_mean = q / area;
+  const double in = -patch_flux(mesh, f, "inlet"), out = patch_flux(mesh, f, "outlet");
+  std::printf(
+      "[ info ] Re %g: %zu cells, %d Picard steps; -dp/dz %.5f vs Hagen-Poiseuille %.5f (%.2f%%); "
+      "centreline %.4f vs 2 x mean %.4f (%.2f%%); flux in %.8f out %.8f\n",
+      re, mesh.cell_count(), report.iterations, gradient, hagen_poiseuille,
+      100 * (gradient / hagen_poiseuille - 1), u_max, 2 * u_mean, 100 * (u_max / (2 * u_mean) - 1),
+      in, out);
+  EXPECT_NEAR(gradient, hagen_poiseuille, 0.02 * hagen_poiseuille);
+  EXPECT_NEAR(u_max, 2 * u_mean, 0.02 * 2 * u_mean);
+  EXPECT_NEAR(out, in, 1e-6 * in);
+  EXPECT_NEAR(in, q, 1e-9 * q);
+}
+
+TEST(Poiseuille, PressureDropAndCentrelineAtLowReynolds) {
+  check_poiseuille(1.0);
+}
+TEST(Poiseuille, PressureDropAndCentrelineAtRe610) {
+  check_poiseuille(610.0);
+}
+
+TEST(Poiseuille, MissingPatchesAreClearErrors) {
+  const HybridMesh box = testing::box_hex(3);
+  EXPECT_THROW(airflow_conditions(box, InletProfile::uniform, 1.0), Error);
+}
+
+}  // namespace
+}  // namespace naris::ns
