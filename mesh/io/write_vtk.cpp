@@ -74,11 +74,15 @@ void run_writer(Writer* writer, const std::filesystem::path& path) {
 // mesh arrays as VTK XML with raw appended data (VTK's own writer copies every array first and
 // is ~40× slower). The tests read it back with VTK's reader.
 void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
-               const CellFields& cell_fields) {
+               const CellFields& cell_fields, const PointFields& point_fields) {
   const std::size_t cells = mesh.cell_count();
   for (const auto& [name, values] : cell_fields)
     if (values.size() != cells)
       fail("internal: cell field '{}' has {} values for {} cells", name, values.size(), cells);
+  for (const auto& [name, field] : point_fields)
+    if (field.values.size() != static_cast<std::size_t>(field.components) * mesh.nodes.size())
+      fail("internal: point field '{}' has {} values for {} nodes", name, field.values.size(),
+           mesh.nodes.size());
   const std::uint64_t points_bytes = 3 * sizeof(double) * mesh.nodes.size();
   const std::uint64_t conn_bytes =
       sizeof(NodeId) * (4 * mesh.tets.size() + 5 * mesh.pyramids.size() + 8 * mesh.hexes.size());
@@ -110,6 +114,12 @@ void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
     xml += "   <CellData>\n";
     for (const auto& [name, values] : cell_fields) array("Float32", name, 1, field_bytes);
     xml += "   </CellData>\n";
+  }
+  if (!point_fields.empty()) {
+    xml += "   <PointData>\n";
+    for (const auto& [name, field] : point_fields)
+      array("Float32", name, field.components, sizeof(float) * field.values.size());
+    xml += "   </PointData>\n";
   }
   xml += "  </Piece>\n </UnstructuredGrid>\n <AppendedData encoding=\"raw\">\n_";
 
@@ -162,6 +172,15 @@ void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
     for (std::size_t c = 0; c < cells; c += kBlock) {
       block.assign(values.begin() + static_cast<std::ptrdiff_t>(c),
                    values.begin() + static_cast<std::ptrdiff_t>(std::min(cells, c + kBlock)));
+      put(block.data(), block.size() * sizeof(float));
+    }
+  }
+  for (const auto& [name, field] : point_fields) {
+    header(sizeof(float) * field.values.size());
+    for (std::size_t c = 0; c < field.values.size(); c += kBlock) {
+      block.assign(field.values.begin() + static_cast<std::ptrdiff_t>(c),
+                   field.values.begin() +
+                       static_cast<std::ptrdiff_t>(std::min(field.values.size(), c + kBlock)));
       put(block.data(), block.size() * sizeof(float));
     }
   }

@@ -12,9 +12,15 @@ namespace naris {
 
 // Cell arrays are given in the writer's cell order: tets, then pyramids, then hexes.
 using CellFields = std::map<std::string, std::vector<double>>;
+// Point arrays: `components` values per node, node after node.
+struct PointField {
+  int components = 1;
+  std::vector<double> values;
+};
+using PointFields = std::map<std::string, PointField>;
 
 void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
-               const CellFields& cell_fields = {});
+               const CellFields& cell_fields = {}, const PointFields& point_fields = {});
 void write_boundary_vtp(const HybridMesh& mesh, const std::filesystem::path& path);
 void write_stl(const HybridMesh& mesh, const std::filesystem::path& path);
 

@@ -440,4 +440,40 @@ TEST_F(CliRunCase, BadCaseFilesAreClearErrors) {
       "unknown interpolation method");
 }
 
+TEST_F(Cli, SolvesTheFlowThroughACutBall) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const fs::path mesh = dir_ / "out" / "mesh.h5";
+  CliRun r = naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const fs::path solution = dir_ / "out" / "solution";
+  r = naris("solve " + mesh.string() + " --re 20 -o " + solution.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f : {"solution.vtu", "summary.json", "residuals.csv"})
+    EXPECT_TRUE(fs::exists(solution / f)) << f;
+  // Mass balance, as the summary reports it: "flow  X mL/s in, Y mL/s out".
+  const std::regex flow("flow +([0-9.]+) mL/s in, ([0-9.]+) mL/s out");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, flow)) << r.err;
+  EXPECT_GT(std::stod(m[1]), 0.0);
+  EXPECT_NEAR(std::stod(m[2]), std::stod(m[1]), 1e-6 * std::stod(m[1]) + 0.005);
+}
+
+TEST_F(Cli, SolveBadInput) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const fs::path closed = dir_ / "in" / "closed" / "mesh.h5";
+  ASSERT_EQ(naris("mesh " + in.string() + " -o " + closed.string()).status, 0);
+  const std::string o = " -o " + (dir_ / "out" / "solution").string();
+  expect_clean_failure(naris("solve " + closed.string() + o), "no 'inlet' patch");
+  const fs::path cut = dir_ / "in" / "cut" / "mesh.h5";
+  ASSERT_EQ(naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + cut.string()).status,
+            0);
+  expect_clean_failure(naris("solve " + cut.string() + " --re 0" + o), "must be positive");
+  expect_clean_failure(naris("solve " + cut.string() + " --re -5" + o), "must be positive");
+  expect_clean_failure(naris("solve " + cut.string() + " --re nan" + o), "");
+  expect_clean_failure(naris("solve " + (dir_ / "in" / "absent.h5").string() + o), "absent.h5");
+  const fs::path junk = dir_ / "in" / "junk.h5";
+  std::ofstream(junk) << "not hdf5";
+  expect_clean_failure(naris("solve " + junk.string() + o), "junk.h5");
+}
+
 }  // namespace

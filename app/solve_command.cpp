@@ -1,0 +1,68 @@
+// `naris solve`: the steady airflow in a mesh at a target Reynolds number (dissertation 4.2.4).
+#include <memory>
+
+#include "commands.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "ns/airflow_job.h"
+#include "parallel/petsc.h"
+
+namespace naris::app {
+
+void add_solve_command(CLI::App& app) {
+  struct Options {
+    ns::AirflowJob job;
+    std::string profile = "uniform", petsc_options;
+    double inlet_speed = 0.0;
+  };
+  auto o = std::make_shared<Options>();
+  ns::AirflowJob& job = o->job;
+  auto* cmd = app.add_subcommand(
+      "solve",
+      "Solve the steady incompressible airflow in a mesh made by naris mesh (patches inlet, "
+      "outlet, wall): uniform or developed inlet velocity, traction-free outlet, no-slip walls, "
+      "Reynolds-number continuation to the target; writes solution.vtu, summary.json and "
+      "residuals.csv into -o");
+  cmd->add_option("mesh", job.mesh, "mesh.h5 written by naris mesh")->required();
+  cmd->add_option("--re", job.reynolds, "target Reynolds number on the inlet's d_in = 4A/P")
+      ->capture_default_str();
+  cmd->add_option("--inlet-speed", o->inlet_speed,
+                  "mean inlet speed (m/s) instead of --re; Re then follows from it");
+  cmd->add_option("--inlet-profile", o->profile, "uniform or developed (laminar, any shape)")
+      ->check(CLI::IsMember({"uniform", "developed"}))
+      ->capture_default_str();
+  cmd->add_option("--nu", job.viscosity, "kinematic viscosity (m²/s)")->capture_default_str();
+  cmd->add_option("--rho", job.density, "density (kg/m³)")->capture_default_str();
+  cmd->add_option("--re-start", job.start_reynolds, "first Reynolds number of the continuation")
+      ->capture_default_str();
+  cmd->add_option("--max-steps", job.max_steps, "continuation steps at most")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--picard-max", job.picard.max_iterations, "Picard iterations per step at most")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--tolerance", job.picard.tolerance,
+                  "nonlinear residual relative to the load, per step")
+      ->capture_default_str();
+  cmd->add_option("--relaxation", job.picard.relaxation, "Picard under-relaxation (0, 1]")
+      ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--petsc", o->petsc_options,
+                  "PETSc options for the linear solves (prefix ns_), e.g. \"-ns_ksp_monitor\"");
+  cmd->add_option("-o,--output", job.output, "output folder")->capture_default_str();
+  cmd->callback([o] {
+    petsc::Session session;
+    if (session.size() > 1)
+      fail("naris solve runs on one MPI rank in this version; run it without mpirun");
+    if (!o->petsc_options.empty())
+      petsc::check(PetscOptionsInsertString(nullptr, o->petsc_options.c_str()),
+                   "PetscOptionsInsertString");
+    if (o->inlet_speed != 0.0) o->job.inlet_speed = o->inlet_speed;
+    o->job.profile =
+        o->profile == "developed" ? ns::InletProfile::developed : ns::InletProfile::uniform;
+    const ns::AirflowResult r = ns::run_airflow_job(o->job);
+    log_line(ns::format_airflow_summary(o->job, r));
+  });
+}
+
+}  // namespace naris::app

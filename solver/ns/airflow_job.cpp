@@ -1,0 +1,270 @@
+#include "ns/airflow_job.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "io/atomic_file.h"
+#include "io/mesh_h5.h"
+#include "io/write_vtk.h"
+#include "patches/patches.h"
+#include "quality/check.h"
+
+namespace naris::ns {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Area-weighted mean of the nodal pressure over a patch (its faces' corner average).
+double patch_mean(const HybridMesh& mesh, const std::vector<double>& p, int patch) {
+  double sum = 0.0, area = 0.0;
+  auto face = [&](std::span<const NodeId> v) {
+    Eigen::Vector3d an = Eigen::Vector3d::Zero();
+    for (std::size_t k = 1; k + 1 < v.size(); ++k)
+      an += 0.5 *
+            (mesh.nodes[v[k]] - mesh.nodes[v[0]]).cross(mesh.nodes[v[k + 1]] - mesh.nodes[v[0]]);
+    double mean = 0.0;
+    for (NodeId n : v) mean += p[static_cast<std::size_t>(n)];
+    sum += an.norm() * mean / static_cast<double>(v.size());
+    area += an.norm();
+  };
+  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t)
+    if (mesh.boundary_tri_patch[t] == patch) face(mesh.boundary_tris[t]);
+  for (std::size_t q = 0; q < mesh.boundary_quads.size(); ++q)
+    if (mesh.boundary_quad_patch[q] == patch) face(mesh.boundary_quads[q]);
+  return area > 0.0 ? sum / area : 0.0;
+}
+
+// ∫ u·n dA over a patch, outward.
+double patch_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u, int patch) {
+  double flux = 0.0;
+  auto face = [&](std::span<const NodeId> v) {
+    if (v.size() == 3) {
+      const Eigen::Vector3d an =
+          0.5 * (mesh.nodes[v[1]] - mesh.nodes[v[0]]).cross(mesh.nodes[v[2]] - mesh.nodes[v[0]]);
+      flux += an.dot(u[v[0]] + u[v[1]] + u[v[2]]) / 3.0;
+    } else {
+      const Eigen::Vector3d an =
+          0.5 * (mesh.nodes[v[2]] - mesh.nodes[v[0]]).cross(mesh.nodes[v[3]] - mesh.nodes[v[1]]);
+      flux += an.dot(u[v[0]] + u[v[1]] + u[v[2]] + u[v[3]]) / 4.0;
+    }
+  };
+  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t)
+    if (mesh.boundary_tri_patch[t] == patch) face(mesh.boundary_tris[t]);
+  for (std::size_t q = 0; q < mesh.boundary_quads.size(); ++q)
+    if (mesh.boundary_quad_patch[q] == patch) face(mesh.boundary_quads[q]);
+  return flux;
+}
+
+void check_job(const AirflowJob& job) {
+  if (!(job.reynolds > 0.0) || !std::isfinite(job.reynolds))
+    fail("the Reynolds number must be positive and finite (got {})", job.reynolds);
+  if (job.inlet_speed && (!(*job.inlet_speed > 0.0) || !std::isfinite(*job.inlet_speed)))
+    fail("the inlet speed must be positive and finite (got {} m/s)", *job.inlet_speed);
+  if (!(job.viscosity > 0.0) || !std::isfinite(job.viscosity))
+    fail("the viscosity must be positive and finite (got {} m²/s)", job.viscosity);
+  if (!(job.density > 0.0) || !std::isfinite(job.density))
+    fail("the density must be positive and finite (got {} kg/m³)", job.density);
+  if (!(job.start_reynolds > 0.0)) fail("the starting Reynolds number must be positive");
+}
+
+}  // namespace
+
+AirflowResult run_airflow_job(const AirflowJob& job) {
+  check_job(job);
+  Stopwatch total;
+  AirflowResult r;
+  HybridMesh mesh = read_mesh_h5(job.mesh);
+  r.cells = mesh.cell_count();
+  r.nodes = mesh.nodes.size();
+  const int inlet = mesh.patch_id("inlet"), outlet = mesh.patch_id("outlet");
+  if (inlet < 0 || outlet < 0)
+    fail("{}: the mesh has no '{}' patch; mesh it with --inlet and --outlet", job.mesh.string(),
+         inlet < 0 ? "inlet" : "outlet");
+  const MeshCheck check = check_mesh(mesh);
+  if (check.nonpositive_cells)
+    fail("{}: {} inverted or flat cells (smallest volume {:.3g} mm³); remesh it with naris mesh",
+         job.mesh.string(), check.nonpositive_cells, check.min_volume);
+  if (!check.valid())
+    fail("{}: the mesh is not valid ({}); remesh it with naris mesh", job.mesh.string(),
+         check.describe());
+  for (const auto& p : patch_report(mesh))
+    if (p.name == "inlet") {
+      r.inlet_area_mm2 = p.area;
+      r.inlet_perimeter_mm = p.perimeter;
+      r.d_in_mm = p.hydraulic_diameter();
+    }
+  if (!(r.d_in_mm > 0.0)) fail("{}: the inlet patch has no area", job.mesh.string());
+  const double d_in = r.d_in_mm * 1e-3;
+  r.u_in = job.inlet_speed ? *job.inlet_speed : job.reynolds * job.viscosity / d_in;
+  r.reynolds = r.u_in * d_in / job.viscosity;
+
+  // Every input is checked: only now does the job touch the output folder.
+  ensure_writable_folder(job.output);
+  log_line(fmt::format("naris solve: {} ({} cells), Re {:.1f} on d_in {:.3f} mm, U_in {:.4f} m/s",
+                       job.mesh.string(), r.cells, r.reynolds, r.d_in_mm, r.u_in));
+
+  // Nondimensional geometry: lengths in units of d_in.
+  for (auto& x : mesh.nodes) x /= r.d_in_mm;
+  InletSummary inlet_summary;
+  const DirichletConditions bc = airflow_conditions(mesh, job.profile, 1.0, &inlet_summary);
+
+  // Reynolds-number continuation: each step warm-started from the last converged one; the
+  // step grows after an easy step and is halved after a failed one.
+  FlowField field, last_good;
+  bool have_solution = false;
+  double re = std::min(job.start_reynolds, r.reynolds), step = re;
+  double reached = 0.0;
+  for (int s = 0; s < job.max_steps; ++s) {
+    ContinuationStep cs;
+    cs.reynolds = re;
+    Stopwatch clock;
+    PicardReport report;
+    try {
+      field = solve_navier_stokes(mesh, 1.0 / re, {}, bc, job.picard, &report,
+                                  have_solution ? &last_good : nullptr);
+      cs.converged = report.converged;
+    } catch (const Error& e) {
+      cs.converged = false;  // a diverged iteration: treated as a failed step
+      log_line(fmt::format("  Re {:.1f}: {}", re, e.what()));
+    }
+    cs.iterations = report.iterations;
+    cs.residuals = report.residuals;
+    cs.residual = report.residuals.empty() ? NAN : report.residuals.back();
+    cs.seconds = clock.seconds();
+    r.steps.push_back(cs);
+    log_line(fmt::format("  Re {:8.1f}: {} after {} Picard steps, residual {:.2e}, {:.1f} s", re,
+                         cs.converged ? "converged" : "FAILED", cs.iterations, cs.residual,
+                         cs.seconds));
+    if (cs.converged) {
+      last_good = field;
+      have_solution = true;
+      reached = re;
+      if (re >= r.reynolds) break;
+      if (cs.iterations < job.picard.max_iterations / 3) step *= 1.5;
+      re = std::min(r.reynolds, re + step);
+    } else {
+      if (!have_solution)
+        step = re *= 0.5;  // the very first step: start lower
+      else {
+        step *= 0.5;
+        re = reached + step;
+      }
+      if (step < 1e-3 * r.reynolds)
+        fail("the continuation stalled at Re {:.1f} (target {:.1f}): the step fell below {:.2f}",
+             reached, r.reynolds, 1e-3 * r.reynolds);
+    }
+  }
+  if (reached < r.reynolds)
+    fail("the continuation reached Re {:.1f} of {:.1f} in {} steps", reached, r.reynolds,
+         job.max_steps);
+
+  // SI results.
+  const double u = r.u_in, pscale = job.density * u * u;
+  r.flow_ml_s = u * r.inlet_area_mm2;  // m/s × mm² = 1e-6 m³/s = mL/s
+  r.outlet_flow_ml_s = patch_flux(mesh, last_good.velocity, outlet) * u * r.d_in_mm * r.d_in_mm;
+  r.pressure_drop_pa =
+      (patch_mean(mesh, last_good.pressure, inlet) - patch_mean(mesh, last_good.pressure, outlet)) *
+      pscale;
+  r.resistance = r.pressure_drop_pa / r.flow_ml_s;
+  for (const auto& v : last_good.velocity) r.max_speed = std::max(r.max_speed, v.norm() * u);
+
+  // Files, in millimetres again.
+  for (auto& x : mesh.nodes) x *= r.d_in_mm;
+  PointFields fields;
+  auto vector_field = [&](double scale) {
+    PointField f{3, {}};
+    f.values.reserve(3 * last_good.velocity.size());
+    for (const auto& v : last_good.velocity)
+      for (int c = 0; c < 3; ++c) f.values.push_back(v[c] * scale);
+    return f;
+  };
+  auto scalar_field = [&](double scale) {
+    PointField f{1, {}};
+    for (double p : last_good.pressure) f.values.push_back(p * scale);
+    return f;
+  };
+  fields["velocity"] = vector_field(u);
+  fields["pressure"] = scalar_field(pscale);
+  fields["velocity_nondimensional"] = vector_field(1.0);
+  fields["pressure_nondimensional"] = scalar_field(1.0);
+  const fs::path vtu = job.output / "solution.vtu";
+  write_vtu(mesh, vtu, {}, fields);
+  r.written.push_back(vtu.string());
+
+  const fs::path csv = job.output / "residuals.csv";
+  {
+    AtomicOutput out(csv);
+    std::ofstream f(out.temp_path());
+    f << "step,reynolds,converged,picard_iteration,residual\n";
+    for (std::size_t s = 0; s < r.steps.size(); ++s)
+      for (std::size_t i = 0; i < r.steps[s].residuals.size(); ++i)
+        f << s << ',' << r.steps[s].reynolds << ',' << r.steps[s].converged << ',' << i << ','
+          << fmt::format("{:.6e}", r.steps[s].residuals[i]) << '\n';
+    if (!f) fail("{}: write failed", csv.string());
+    f.close();
+    out.commit();
+  }
+  r.written.push_back(csv.string());
+  r.seconds = total.seconds();
+  r.peak_memory = peak_memory_bytes();
+
+  const fs::path json = job.output / "summary.json";
+  {
+    std::string steps;
+    for (const auto& s : r.steps)
+      steps += fmt::format(
+          "{}{{\"reynolds\": {:.6g}, \"converged\": {}, \"picard_iterations\": {}, \"residual\": "
+          "{:.6e}, \"seconds\": {:.3f}}}",
+          steps.empty() ? "" : ", ", s.reynolds, s.converged ? "true" : "false", s.iterations,
+          s.residual, s.seconds);
+    AtomicOutput out(json);
+    std::ofstream f(out.temp_path());
+    f << fmt::format(
+        "{{\n  \"mesh\": \"{}\",\n  \"cells\": {},\n  \"nodes\": {},\n  \"reynolds\": {:.6g},\n"
+        "  \"inlet_speed_m_s\": {:.6g},\n  \"inlet_hydraulic_diameter_mm\": {:.6g},\n"
+        "  \"inlet_area_mm2\": {:.6g},\n  \"inlet_perimeter_mm\": {:.6g},\n"
+        "  \"viscosity_m2_s\": {:.6g},\n  \"density_kg_m3\": {:.6g},\n  \"inlet_profile\": "
+        "\"{}\",\n"
+        "  \"flow_ml_s\": {:.6g},\n  \"outlet_flow_ml_s\": {:.6g},\n  \"pressure_drop_pa\": "
+        "{:.6g},\n"
+        "  \"resistance_pa_s_ml\": {:.6g},\n  \"max_speed_m_s\": {:.6g},\n  \"continuation\": "
+        "[{}],\n"
+        "  \"seconds\": {:.3f},\n  \"peak_memory_mb\": {:.1f}\n}}\n",
+        job.mesh.string(), r.cells, r.nodes, r.reynolds, r.u_in, r.d_in_mm, r.inlet_area_mm2,
+        r.inlet_perimeter_mm, job.viscosity, job.density,
+        job.profile == InletProfile::uniform ? "uniform" : "developed", r.flow_ml_s,
+        r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance, r.max_speed, steps, r.seconds,
+        r.peak_memory / 1048576.0);
+    if (!f) fail("{}: write failed", json.string());
+    f.close();
+    out.commit();
+  }
+  r.written.push_back(json.string());
+  return r;
+}
+
+std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r) {
+  int picard = 0;
+  for (const auto& s : r.steps) picard += s.iterations;
+  return fmt::format(
+      "naris solve: {} ({} cells, {} nodes)\n"
+      "  inlet     A {:.2f} mm², P {:.2f} mm, d_in = 4A/P {:.3f} mm; {} profile\n"
+      "  scales    Re {:.1f}, U_in {:.4f} m/s, ν {:.3g} m²/s, ρ {:.3g} kg/m³\n"
+      "  flow      {:.2f} mL/s in, {:.2f} mL/s out\n"
+      "  pressure  drop inlet→outlet {:.3f} Pa; resistance {:.4f} Pa·s/mL\n"
+      "  speed     max {:.3f} m/s\n"
+      "  solve     {} continuation steps, {} Picard steps, {:.1f} s, peak {:.0f} MB\n"
+      "  wrote     {}",
+      job.mesh.filename().string(), r.cells, r.nodes, r.inlet_area_mm2, r.inlet_perimeter_mm,
+      r.d_in_mm, job.profile == InletProfile::uniform ? "uniform" : "developed", r.reynolds, r.u_in,
+      job.viscosity, job.density, r.flow_ml_s, r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance,
+      r.max_speed, r.steps.size(), picard, r.seconds, r.peak_memory / 1048576.0,
+      fmt::join(r.written, "\n            "));
+}
+
+}  // namespace naris::ns

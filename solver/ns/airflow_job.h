@@ -1,0 +1,54 @@
+#pragma once
+// `naris solve` as a library call: the steady airflow in a mesh made by `naris mesh` at a
+// target Reynolds number on the naris hydraulic diameter, reached by continuation in Re, in
+// nondimensional variables (x* = x/d_in, u* = u/U_in, p* = p/(ρU_in²); eq. 4.3–4.7), reported
+// and written in SI.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ns/boundary_conditions.h"
+#include "ns/navier_stokes.h"
+
+namespace naris::ns {
+
+struct AirflowJob {
+  std::filesystem::path mesh;                 // mesh.h5 with inlet and outlet patches
+  std::filesystem::path output = "solution";  // folder
+  double reynolds = 610.0;                    // target, on d_in = 4A/P of the inlet
+  std::optional<double> inlet_speed;          // m/s; when given, Re follows from it
+  double viscosity = 1.5e-5;                  // kinematic, m²/s (air)
+  double density = 1.2;                       // kg/m³ (air)
+  InletProfile profile = InletProfile::uniform;
+  double start_reynolds = 50.0;  // the first continuation step
+  int max_steps = 40;            // continuation steps, failed ones included
+  PicardOptions picard;          // per step
+};
+
+struct ContinuationStep {
+  double reynolds = 0.0;
+  bool converged = false;
+  int iterations = 0;
+  double residual = 0.0, seconds = 0.0;
+  std::vector<double> residuals;
+};
+
+struct AirflowResult {
+  double d_in_mm = 0.0, inlet_area_mm2 = 0.0, inlet_perimeter_mm = 0.0;
+  double u_in = 0.0, reynolds = 0.0;
+  double flow_ml_s = 0.0, pressure_drop_pa = 0.0, resistance = 0.0, max_speed = 0.0;
+  double outlet_flow_ml_s = 0.0;  // mass balance check
+  std::vector<ContinuationStep> steps;
+  std::size_t cells = 0, nodes = 0;
+  double seconds = 0.0;
+  std::size_t peak_memory = 0;
+  std::vector<std::string> written;
+};
+
+// Throws naris::Error for a bad mesh or setting, or when the continuation cannot reach the
+// target (with the last Re reached; the files of the last converged step are still written).
+AirflowResult run_airflow_job(const AirflowJob& job);
+std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r);
+
+}  // namespace naris::ns
