@@ -14,15 +14,13 @@ void add_interpolate_command(CLI::App& app) {
     int insert = -1;
     double spacing = 0.0;
   };
-  auto o = std::make_shared<Options>();
-  InterpolateJob& job = o->job;
-  auto* cmd = app.add_subcommand(
-      "interpolate",
+  auto [o, cmd] = add_stage<Options>(
+      app, "interpolate",
       "Insert slices between the acquired slices of a volume along its thick axis by "
       "hierarchical spline-based registration (HSR), or linear / shape-based interpolation; "
       "gray values stay HU (int16 NRRD), 0/1 masks stay labelmaps");
-  cmd->add_option("input", job.input, "volume (.nrrd, .nii, .mha, .vti or a DICOM folder)")
-      ->required();
+  InterpolateJob& job = o->job;
+  add_volume_input(cmd, job.input, "volume");
   cmd->add_option("--method", o->method, "hsr, linear or shape")
       ->check(CLI::IsMember({"hsr", "linear", "shape"}))
       ->capture_default_str();

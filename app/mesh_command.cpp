@@ -21,9 +21,7 @@ void add_mesh_command(CLI::App& app) {
       "Mesh the inside of an image with marching volume elements: hexahedra inside, tetrahedra "
       "at the wall, pyramids between; writes mesh.h5 (+ .xdmf), mesh.vtu, boundary.vtp, "
       "surface.stl, mesh.msh and mesh.json beside -o.");
-  cmd->add_option("input", options_job->input,
-                  "image: .nrrd/.nhdr, .nii/.nii.gz, .mha/.mhd, .vti, or a DICOM folder")
-      ->required();
+  add_volume_input(cmd, options_job->input, "image");
   auto* threshold = cmd->add_option("--threshold", options_job->threshold,
                                     "inside is below T (CT air; see --inside)");
   auto* label = cmd->add_option("--label", options_job->label,

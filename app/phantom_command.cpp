@@ -8,9 +8,8 @@
 namespace naris::app {
 
 void add_phantom_command(CLI::App& app) {
-  auto job = std::make_shared<PhantomJob>();
-  auto* cmd = app.add_subcommand(
-      "phantom",
+  auto [job, cmd] = add_stage<PhantomJob>(
+      app, "phantom",
       "Write a procedural CT scan of a right human nasal cavity (nostril, vestibule, valve, "
       "meatuses between turbinate folds, olfactory slit, nasopharynx): thick coronal slices "
       "with partial volume and noise, in HU; the subject number varies the anatomy");

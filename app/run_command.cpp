@@ -291,9 +291,8 @@ void run_case(const RunOptions& o) {
 }  // namespace
 
 void add_run_command(CLI::App& app) {
-  auto o = std::make_shared<RunOptions>();
-  auto* cmd = app.add_subcommand(
-      "run",
+  auto [o, cmd] = add_stage<RunOptions>(
+      app, "run",
       "Run a case file: phantom or input CT → interpolate → segment → mesh, each stage writing "
       "its file in the case's output folder and skipped when its outputs are newer than its "
       "inputs and its settings are unchanged");

@@ -13,15 +13,13 @@ void add_segment_command(CLI::App& app) {
     std::string inside = "below";
     bool all_components = false;
   };
-  auto o = std::make_shared<Options>();
-  SegmentJob& job = o->job;
-  auto* cmd = app.add_subcommand(
-      "segment",
+  auto [o, cmd] = add_stage<Options>(
+      app, "segment",
       "Segment the airway of a CT volume: threshold (automatic: the HU histogram's valley nearest "
       "−1000), 26-connected region growing from seeds (or every voxel below the threshold), "
       "largest component; writes a labelmap NRRD that 3D Slicer opens");
-  cmd->add_option("input", job.input, "CT volume (.nrrd, .nii, .mha, .vti or a DICOM folder)")
-      ->required();
+  SegmentJob& job = o->job;
+  add_volume_input(cmd, job.input, "CT volume");
   cmd->add_option("--threshold", job.threshold, "HU threshold, or 'auto'")->capture_default_str();
   cmd->add_option("--inside", o->inside, "the airway is 'below' or 'above' the threshold")
       ->check(CLI::IsMember({"below", "above"}))
