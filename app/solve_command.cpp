@@ -13,6 +13,7 @@ void add_solve_command(CLI::App& app) {
   struct Options {
     ns::AirflowJob job;
     std::string profile = "uniform", petsc_options;
+    std::filesystem::path restart;
     double inlet_speed = 0.0;
   };
   auto o = std::make_shared<Options>();
@@ -21,8 +22,8 @@ void add_solve_command(CLI::App& app) {
       "solve",
       "Solve the steady incompressible airflow in a mesh made by naris mesh (patches inlet, "
       "outlet, wall): uniform or developed inlet velocity, traction-free outlet, no-slip walls, "
-      "Reynolds-number continuation to the target; writes solution.vtu, summary.json and "
-      "residuals.csv into -o");
+      "Reynolds-number continuation to the target; writes solution.h5 (+ .xdmf), solution.vtu, "
+      "summary.json, residuals.csv and checkpoint.h5 into -o");
   cmd->add_option("mesh", job.mesh, "mesh.h5 written by naris mesh")->required();
   cmd->add_option("--re", job.reynolds, "target Reynolds number on the inlet's d_in = 4A/P")
       ->capture_default_str();
@@ -47,6 +48,9 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("--relaxation", job.picard.relaxation, "Picard under-relaxation (0, 1]")
       ->check(CLI::Range(0.01, 1.0))
       ->capture_default_str();
+  cmd->add_option("--restart", o->restart,
+                  "resume the continuation from a checkpoint (the -o folder's checkpoint.h5 is "
+                  "rewritten after every converged step)");
   cmd->add_option("--petsc", o->petsc_options,
                   "PETSc options for the linear solves (prefix ns_), e.g. \"-ns_ksp_monitor\"");
   cmd->add_option("-o,--output", job.output, "output folder")->capture_default_str();
@@ -58,6 +62,7 @@ void add_solve_command(CLI::App& app) {
       petsc::check(PetscOptionsInsertString(nullptr, o->petsc_options.c_str()),
                    "PetscOptionsInsertString");
     if (o->inlet_speed != 0.0) o->job.inlet_speed = o->inlet_speed;
+    if (!o->restart.empty()) o->job.restart = o->restart;
     o->job.profile =
         o->profile == "developed" ? ns::InletProfile::developed : ns::InletProfile::uniform;
     const ns::AirflowResult r = ns::run_airflow_job(o->job);

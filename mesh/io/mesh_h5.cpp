@@ -9,7 +9,7 @@
 
 #include "core/error.h"
 #include "io/atomic_file.h"
-#include "io/hdf5_handle.h"
+#include "io/hdf5_table.h"
 
 namespace naris {
 namespace fs = std::filesystem;
@@ -17,84 +17,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr int kFormatVersion = 1;
-
-// HDF5 prints its own error stack by default; naris reports errors itself.
-struct SilenceHdf5 {
-  H5E_auto2_t func = nullptr;
-  void* data = nullptr;
-  SilenceHdf5() {
-    H5Eget_auto2(H5E_DEFAULT, &func, &data);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~SilenceHdf5() { H5Eset_auto2(H5E_DEFAULT, func, data); }
-};
-
-void check(herr_t status, const fs::path& path, const char* what) {
-  if (status < 0) fail("{}: HDF5 failed to {}", path.string(), what);
-}
-
-H5Handle make_group(hid_t parent, const char* name, const fs::path& path) {
-  H5Handle g(H5Gcreate2(parent, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
-  if (!g.valid()) fail("{}: cannot create group {}", path.string(), name);
-  return g;
-}
-
-// A 2D dataset [rows, cols], chunked so that large meshes stream through the library.
-void write_table(hid_t parent, const char* name, hid_t mem_type, hid_t file_type, const void* data,
-                 hsize_t rows, hsize_t cols, const fs::path& path) {
-  const int rank = cols > 1 ? 2 : 1;
-  const hsize_t dims[2] = {rows, cols};
-  H5Handle space(H5Screate_simple(rank, dims, nullptr), H5Sclose);
-  H5Handle props(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
-  if (rows > 0) {
-    const hsize_t chunk[2] = {std::min<hsize_t>(rows, 1u << 16), cols};
-    check(H5Pset_chunk(props.get(), rank, chunk), path, "set chunking");
-  }
-  H5Handle set(
-      H5Dcreate2(parent, name, file_type, space.get(), H5P_DEFAULT, props.get(), H5P_DEFAULT),
-      H5Dclose);
-  if (!set.valid()) fail("{}: cannot create dataset {}", path.string(), name);
-  if (rows > 0)
-    check(H5Dwrite(set.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), path, "write data");
-}
-
-void write_string_attribute(hid_t obj, const char* name, const std::string& value,
-                            const fs::path& path) {
-  H5Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
-  H5Tset_size(type.get(), std::max<std::size_t>(1, value.size()));
-  H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
-  H5Handle attr(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-  check(H5Awrite(attr.get(), type.get(), value.empty() ? " " : value.c_str()), path,
-        "write attribute");
-}
-
-std::string read_string_attribute(hid_t obj, const char* name, const fs::path& path) {
-  if (H5Aexists(obj, name) <= 0)
-    fail("{}: not a naris mesh file (no '{}' attribute)", path.string(), name);
-  H5Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
-  H5Handle type(H5Aget_type(attr.get()), H5Tclose);
-  std::string value(H5Tget_size(type.get()), '\0');
-  check(H5Aread(attr.get(), type.get(), value.data()), path, "read attribute");
-  while (!value.empty() && value.back() == '\0') value.pop_back();
-  return value;
-}
-
-template <class Array>
-void read_table(hid_t file, const char* name, hid_t mem_type, std::size_t cols, Array& out,
-                const fs::path& path) {
-  H5Handle set(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose);
-  if (!set.valid()) fail("{}: missing dataset {}", path.string(), name);
-  H5Handle space(H5Dget_space(set.get()), H5Sclose);
-  hsize_t dims[2] = {0, 1};
-  const int rank = H5Sget_simple_extent_ndims(space.get());
-  H5Sget_simple_extent_dims(space.get(), dims, nullptr);
-  if ((cols > 1 && (rank != 2 || dims[1] != cols)) || (cols == 1 && rank != 1))
-    fail("{}: dataset {} has the wrong shape", path.string(), name);
-  out.resize(dims[0]);
-  if (dims[0] > 0)
-    check(H5Dread(set.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), path,
-          "read data");
-}
 
 void write_xdmf(const HybridMesh& mesh, const fs::path& h5_path) {
   const std::string h5 = h5_path.filename().string();
@@ -187,14 +109,16 @@ HybridMesh read_mesh_h5(const fs::path& path) {
   if (H5Fis_hdf5(path.c_str()) <= 0) fail("{}: not an HDF5 file", path.string());
   H5Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   if (!file.valid()) fail("{}: cannot open the HDF5 file (corrupt?)", path.string());
-  if (read_string_attribute(file.get(), "format", path) != "naris-mesh")
+  if (read_string_attribute(file.get(), "format", path, "a naris mesh file") != "naris-mesh")
     fail("{}: not a naris mesh file", path.string());
-  const std::string version = read_string_attribute(file.get(), "version", path);
+  const std::string version =
+      read_string_attribute(file.get(), "version", path, "a naris mesh file");
   if (version != std::to_string(kFormatVersion))
     fail("{}: mesh format version {} is not supported (this naris reads version {})", path.string(),
          version, kFormatVersion);
   HybridMesh mesh;
-  std::istringstream names(read_string_attribute(file.get(), "patch_names", path));
+  std::istringstream names(
+      read_string_attribute(file.get(), "patch_names", path, "a naris mesh file"));
   for (std::string line; std::getline(names, line);) mesh.patch_names.push_back(line);
   read_table(file.get(), "nodes", H5T_NATIVE_DOUBLE, 3, mesh.nodes, path);
   read_table(file.get(), "cells/tet", H5T_NATIVE_INT32, 4, mesh.tets, path);

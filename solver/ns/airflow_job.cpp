@@ -11,6 +11,7 @@
 #include "io/atomic_file.h"
 #include "io/mesh_h5.h"
 #include "io/write_vtk.h"
+#include "ns/solution_file.h"
 #include "patches/patches.h"
 #include "quality/check.h"
 
@@ -79,6 +80,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   Stopwatch total;
   AirflowResult r;
   HybridMesh mesh = read_mesh_h5(job.mesh);
+  const std::uint64_t fingerprint = mesh_fingerprint(mesh);
   r.cells = mesh.cell_count();
   r.nodes = mesh.nodes.size();
   const int inlet = mesh.patch_id("inlet"), outlet = mesh.patch_id("outlet");
@@ -103,6 +105,20 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   r.u_in = job.inlet_speed ? *job.inlet_speed : job.reynolds * job.viscosity / d_in;
   r.reynolds = r.u_in * d_in / job.viscosity;
 
+  std::optional<SolutionState> resume;
+  if (job.restart) {
+    resume = read_solution_h5(*job.restart);
+    if (resume->mesh_fingerprint != fingerprint || resume->field.pressure.size() != r.nodes)
+      fail("{}: the checkpoint belongs to another mesh than {} ({} nodes vs {})",
+           job.restart->string(), job.mesh.string(), resume->field.pressure.size(), r.nodes);
+    if (std::abs(resume->d_in_mm - r.d_in_mm) > 1e-9 * r.d_in_mm)
+      fail("{}: the checkpoint was scaled with d_in {} mm, this mesh has {} mm",
+           job.restart->string(), resume->d_in_mm, r.d_in_mm);
+    r.restarted_from = resume->reynolds;
+    if (resume->reynolds >= r.reynolds)
+      fail("{}: the checkpoint is at Re {:.1f}, at or past the target {:.1f}: nothing to continue",
+           job.restart->string(), resume->reynolds, r.reynolds);
+  }
   // Every input is checked: only now does the job touch the output folder.
   ensure_writable_folder(job.output);
   log_line(fmt::format("naris solve: {} ({} cells), Re {:.1f} on d_in {:.3f} mm, U_in {:.4f} m/s",
@@ -119,7 +135,28 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   bool have_solution = false;
   double re = std::min(job.start_reynolds, r.reynolds), step = re;
   double reached = 0.0;
-  for (int s = 0; s < job.max_steps; ++s) {
+  if (resume) {
+    last_good = resume->field;
+    have_solution = true;
+    reached = resume->reynolds;
+    step = std::max(reached, 1.0);
+    re = std::min(r.reynolds, reached + step);
+    log_line(fmt::format("  restarting from Re {:.1f} ({})", reached, job.restart->string()));
+  }
+  const fs::path checkpoint = job.output / "checkpoint.h5";
+  auto state_at = [&](double at) {
+    SolutionState s;
+    s.field = last_good;
+    s.reynolds = at;
+    s.target_reynolds = r.reynolds;
+    s.u_in = r.u_in;
+    s.d_in_mm = r.d_in_mm;
+    s.density = job.density;
+    s.viscosity = job.viscosity;
+    s.mesh_fingerprint = fingerprint;
+    return s;
+  };
+  for (int s = 0; s < job.max_steps && reached < r.reynolds; ++s) {
     ContinuationStep cs;
     cs.reynolds = re;
     Stopwatch clock;
@@ -144,6 +181,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       last_good = field;
       have_solution = true;
       reached = re;
+      write_solution_h5(state_at(re), checkpoint);  // the last good step, always on disk
       if (re >= r.reynolds) break;
       if (cs.iterations < job.picard.max_iterations / 3) step *= 1.5;
       re = std::min(r.reynolds, re + step);
@@ -155,13 +193,16 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
         re = reached + step;
       }
       if (step < 1e-3 * r.reynolds)
-        fail("the continuation stalled at Re {:.1f} (target {:.1f}): the step fell below {:.2f}",
-             reached, r.reynolds, 1e-3 * r.reynolds);
+        fail("the continuation stalled at Re {:.1f} (target {:.1f}): the step fell below {:.2f}{}",
+             reached, r.reynolds, 1e-3 * r.reynolds,
+             have_solution ? "; " + checkpoint.string() + " holds the last converged step" : "");
     }
   }
   if (reached < r.reynolds)
-    fail("the continuation reached Re {:.1f} of {:.1f} in {} steps", reached, r.reynolds,
-         job.max_steps);
+    fail(
+        "the continuation reached Re {:.1f} of {:.1f} in {} steps; {} holds that step (resume "
+        "with --restart)",
+        reached, r.reynolds, job.max_steps, checkpoint.string());
 
   // SI results.
   const double u = r.u_in, pscale = job.density * u * u;
@@ -192,6 +233,10 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   fields["pressure"] = scalar_field(pscale);
   fields["velocity_nondimensional"] = vector_field(1.0);
   fields["pressure_nondimensional"] = scalar_field(1.0);
+  const fs::path h5 = job.output / "solution.h5";
+  write_solution_h5(state_at(reached), h5, &mesh, job.mesh);
+  r.written.push_back(h5.string());
+  r.written.push_back(fs::path(h5).replace_extension(".xdmf").string());
   const fs::path vtu = job.output / "solution.vtu";
   write_vtu(mesh, vtu, {}, fields);
   r.written.push_back(vtu.string());
@@ -245,6 +290,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     out.commit();
   }
   r.written.push_back(json.string());
+  r.written.push_back(checkpoint.string());
   return r;
 }
 

@@ -24,6 +24,8 @@ struct AirflowJob {
   double start_reynolds = 50.0;  // the first continuation step
   int max_steps = 40;            // continuation steps, failed ones included
   PicardOptions picard;          // per step
+  // Resume from this checkpoint (a solution file of the same mesh) instead of starting low.
+  std::optional<std::filesystem::path> restart;
 };
 
 struct ContinuationStep {
@@ -41,7 +43,7 @@ struct AirflowResult {
   double outlet_flow_ml_s = 0.0;  // mass balance check
   std::vector<ContinuationStep> steps;
   std::size_t cells = 0, nodes = 0;
-  double seconds = 0.0;
+  double seconds = 0.0, restarted_from = 0.0;  // the checkpoint's Re, 0 without --restart
   std::size_t peak_memory = 0;
   std::vector<std::string> written;
 };

@@ -209,7 +209,14 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
   check(VecDuplicate(system.solution(), current.out()), "VecDuplicate");
   // Stokes first (a = 0) unless warm-started; then Picard on a = u.
   bool stokes = initial == nullptr;
-  for (int it = 0; it <= options.max_iterations; ++it) {
+  // Damped Picard: the update U ← U + ω (U* − U) starts at the given relaxation; when the
+  // residual grows, ω is halved and the step retaken from the previous iterate (no new solve);
+  // after a step that halves the residual ω grows back towards the given value.
+  double omega = options.relaxation, previous_norm = INFINITY;
+  FlowField previous, target;  // the iterate a step started from, and the solve's answer
+  int solves = 0;
+  for (int it = 0; solves <= options.max_iterations + 1 && it < 4 * options.max_iterations + 8;
+       ++it) {
     from_field(field, current);
     system.assemble(
         stokes ? std::vector<Eigen::Vector3d>(n, Eigen::Vector3d::Zero()) : field.velocity, nu,
@@ -224,32 +231,49 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
       double norm = 0.0, load = 0.0;
       check(VecNorm(system.residual(), NORM_2, &norm), "VecNorm");
       check(VecNorm(system.rhs(), NORM_2, &load), "VecNorm");
-      if (!std::isfinite(norm)) fail("the nonlinear iteration diverged (residual {})", norm);
-      r.residuals.push_back(norm);
+      if (!std::isfinite(norm) && previous.pressure.empty())
+        fail("the nonlinear iteration diverged (residual {})", norm);
       // Relative to the load (forces and boundary data): an iterate that starts close, as a
       // warm start does, must not be held to a fraction of its own small first residual.
       if (norm <= options.absolute_tolerance || norm <= options.tolerance * load) {
+        r.residuals.push_back(norm);
         r.converged = true;
         break;
       }
-      if (it == options.max_iterations) break;
+      if (!(norm < previous_norm) && !previous.pressure.empty() && omega > 1.0 / 64) {
+        omega *= 0.5;
+        for (std::size_t k = 0; k < n; ++k) {
+          field.velocity[k] =
+              previous.velocity[k] + omega * (target.velocity[k] - previous.velocity[k]);
+          field.pressure[k] =
+              previous.pressure[k] + omega * (target.pressure[k] - previous.pressure[k]);
+        }
+        continue;
+      }
+      if (!std::isfinite(norm)) fail("the nonlinear iteration diverged (residual {})", norm);
+      r.residuals.push_back(norm);
+      if (norm < 0.5 * previous_norm) omega = std::min(options.relaxation, 2.0 * omega);
+      previous_norm = norm;
+      if (solves > options.max_iterations) break;
     }
     check(KSPSetOperators(ksp, system.matrix(), system.matrix()), "KSPSetOperators");
     check(KSPSolve(ksp, system.rhs(), system.solution()), "KSPSolve");
+    ++solves;
     KSPConvergedReason reason;
     check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
     if (reason < 0) fail("the linear solver failed ({})", KSPConvergedReasons[reason]);
-    if (stokes || options.relaxation == 1.0) {
+    if (stokes) {
       to_field(system.solution(), field);
     } else {
-      FlowField next = field;
-      to_field(system.solution(), next);
+      previous = field;
+      target = field;
+      to_field(system.solution(), target);
       for (std::size_t k = 0; k < n; ++k) {
-        field.velocity[k] += options.relaxation * (next.velocity[k] - field.velocity[k]);
-        field.pressure[k] += options.relaxation * (next.pressure[k] - field.pressure[k]);
+        field.velocity[k] += omega * (target.velocity[k] - field.velocity[k]);
+        field.pressure[k] += omega * (target.pressure[k] - field.pressure[k]);
       }
+      ++r.iterations;
     }
-    if (!stokes) ++r.iterations;
     stokes = false;
   }
   return field;

@@ -1,0 +1,40 @@
+#pragma once
+// The flow solution on disk (HDF5): the nondimensional nodal velocity and pressure, the Reynolds
+// number they belong to, the scales, and a fingerprint of the mesh they were computed on. The
+// same layout serves as the continuation checkpoint (rewritten after every converged step) and
+// as `solution.h5`, which also holds the SI fields and has an XDMF sidecar that takes the
+// geometry from the mesh file, so ParaView opens it.
+//
+//   /  attributes format = "naris-solution", version, reynolds, target_reynolds, u_in (m/s),
+//      d_in_mm, density, viscosity, mesh_fingerprint (hex), nodes
+//   /velocity_nondimensional [nodes, 3], /pressure_nondimensional [nodes]
+//   /velocity [nodes, 3] (m/s), /pressure [nodes] (Pa)             (solution.h5 only)
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "hybrid_mesh.h"
+#include "ns/navier_stokes.h"
+
+namespace naris::ns {
+
+struct SolutionState {
+  FlowField field;  // nondimensional
+  double reynolds = 0.0, target_reynolds = 0.0;
+  double u_in = 0.0, d_in_mm = 0.0, density = 0.0, viscosity = 0.0;
+  std::uint64_t mesh_fingerprint = 0;
+};
+
+// FNV-1a over the node coordinates and the cells: equal meshes, equal fingerprints.
+std::uint64_t mesh_fingerprint(const HybridMesh& mesh);
+
+// Writes atomically. With `mesh_file` (the mesh.h5 the solution belongs to), also writes the SI
+// fields and the XDMF sidecar beside `path`.
+void write_solution_h5(const SolutionState& state, const std::filesystem::path& path,
+                       const HybridMesh* mesh = nullptr,
+                       const std::filesystem::path& mesh_file = {});
+
+// Throws naris::Error for a missing, unreadable or foreign file.
+SolutionState read_solution_h5(const std::filesystem::path& path);
+
+}  // namespace naris::ns
