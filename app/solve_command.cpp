@@ -14,6 +14,7 @@ void add_solve_command(CLI::App& app) {
     ns::AirflowJob job;
     std::string profile = "uniform", petsc_options;
     std::filesystem::path restart;
+    bool verbose = false;
     double inlet_speed = 0.0;
   };
   auto o = std::make_shared<Options>();
@@ -51,6 +52,7 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("--restart", o->restart,
                   "resume the continuation from a checkpoint (the -o folder's checkpoint.h5 is "
                   "rewritten after every converged step)");
+  cmd->add_flag("--verbose", o->verbose, "a line per Picard step");
   cmd->add_option("--petsc", o->petsc_options,
                   "PETSc options for the linear solves (prefix ns_), e.g. \"-ns_ksp_monitor\"");
   cmd->add_option("-o,--output", job.output, "output folder")->capture_default_str();
@@ -63,6 +65,7 @@ void add_solve_command(CLI::App& app) {
                    "PetscOptionsInsertString");
     if (o->inlet_speed != 0.0) o->job.inlet_speed = o->inlet_speed;
     if (!o->restart.empty()) o->job.restart = o->restart;
+    o->job.picard.log_iterations = o->verbose;
     o->job.profile =
         o->profile == "developed" ? ns::InletProfile::developed : ns::InletProfile::uniform;
     const ns::AirflowResult r = ns::run_airflow_job(o->job);

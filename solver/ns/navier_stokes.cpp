@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "ns/oseen_element.h"
 #include "parallel/petsc.h"
 
@@ -261,6 +262,13 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
     ++solves;
     KSPConvergedReason reason;
     check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
+    if (options.log_iterations) {
+      PetscInt linear = 0;
+      check(KSPGetIterationNumber(ksp, &linear), "KSPGetIterationNumber");
+      log_line(fmt::format(
+          "    Picard {:3d}: residual {:.3e}, relaxation {:.3f}, {} linear iterations", solves,
+          stokes ? NAN : previous_norm, stokes ? 1.0 : omega, static_cast<int>(linear)));
+    }
     if (reason < 0) fail("the linear solver failed ({})", KSPConvergedReasons[reason]);
     if (stokes) {
       to_field(system.solution(), field);

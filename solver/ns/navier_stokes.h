@@ -34,6 +34,7 @@ struct PicardOptions {
   double absolute_tolerance = 1e-13;
   double relaxation = 1.0;  // U ← U + ω (U* − U)
   std::string options_prefix = "ns_";
+  bool log_iterations = false;  // a line per Picard step (residual, relaxation, linear iterations)
 };
 
 struct PicardReport {
