@@ -162,7 +162,9 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     Stopwatch clock;
     PicardReport report;
     try {
-      field = solve_navier_stokes(mesh, 1.0 / re, {}, bc, job.picard, &report,
+      PicardOptions picard = job.picard;
+      picard.backflow_patch = outlet;
+      field = solve_navier_stokes(mesh, 1.0 / re, {}, bc, picard, &report,
                                   have_solution ? &last_good : nullptr);
       cs.converged = report.converged;
     } catch (const Error& e) {

@@ -36,7 +36,9 @@ std::vector<std::vector<NodeId>> node_graph(const HybridMesh& mesh) {
 
 class OseenSystem {
  public:
-  explicit OseenSystem(const HybridMesh& mesh, const std::string& prefix) : mesh_(mesh) {
+  OseenSystem(const HybridMesh& mesh, const std::string& prefix, int backflow_patch,
+              double backflow_beta)
+      : mesh_(mesh), backflow_patch_(backflow_patch), backflow_beta_(backflow_beta) {
     const auto graph = node_graph(mesh);
     const PetscInt n = static_cast<PetscInt>(mesh.nodes.size());
     std::vector<PetscInt> nnz(graph.size());
@@ -106,6 +108,7 @@ class OseenSystem {
     assemble_cells<fem::Tet4>(mesh_.tets, advection, nu, f);
     assemble_cells<fem::Pyr5>(mesh_.pyramids, advection, nu, f);
     assemble_cells<fem::Hex8>(mesh_.hexes, advection, nu, f);
+    if (backflow_patch_ >= 0) assemble_backflow(advection);
     check(MatAssemblyBegin(matrix_, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
     check(MatAssemblyEnd(matrix_, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
     check(VecAssemblyBegin(rhs_), "VecAssemblyBegin");
@@ -113,6 +116,55 @@ class OseenSystem {
   }
 
  private:
+  // Outflow stabilization (Bazilevs, Gohean, Hughes, Moser & Zhang 2009): where the flow enters
+  // through the open outlet, the natural condition lets energy in and the iteration can blow
+  // up; −β ∫ (a·n)₋ u·w over the outlet removes exactly that inflow of kinetic energy and is
+  // zero wherever the flow leaves.
+  void assemble_backflow(const std::vector<Eigen::Vector3d>& advection) {
+    auto face = [&](std::span<const NodeId> v) {
+      const int m = static_cast<int>(v.size());
+      Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
+      // Fan triangles from v[0], three edge-midpoint points each (degree 2 on every triangle).
+      for (int k = 1; k + 1 < m; ++k) {
+        const int tri[3] = {0, k, k + 1};
+        const Eigen::Vector3d an =
+            0.5 * (mesh_.nodes[v[tri[1]]] - mesh_.nodes[v[tri[0]]])
+                      .cross(mesh_.nodes[v[tri[2]]] - mesh_.nodes[v[tri[0]]]);
+        const double area = an.norm();
+        if (area <= 0.0) continue;
+        const Eigen::Vector3d normal = an / area;
+        for (int q = 0; q < 3; ++q) {
+          double phi[3] = {0.5, 0.5, 0.5};
+          phi[q] = 0.0;
+          Eigen::Vector3d a = Eigen::Vector3d::Zero();
+          for (int i = 0; i < 3; ++i) a += phi[i] * advection[static_cast<std::size_t>(v[tri[i]])];
+          const double inflow = std::min(0.0, a.dot(normal));
+          if (inflow == 0.0) continue;
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+              M(tri[i], tri[j]) += -backflow_beta_ * inflow * area / 3.0 * phi[i] * phi[j];
+        }
+      }
+      if (M.isZero()) return;
+      Eigen::Matrix<double, 16, 16, Eigen::RowMajor> block =
+          Eigen::Matrix<double, 16, 16, Eigen::RowMajor>::Zero();
+      std::array<PetscInt, 4> ids{};
+      for (int i = 0; i < m; ++i) {
+        ids[static_cast<std::size_t>(i)] = v[static_cast<std::size_t>(i)];
+        for (int j = 0; j < m; ++j)
+          for (int c = 0; c < 3; ++c) block(4 * i + c, 4 * j + c) = M(i, j);
+      }
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> used =
+          block.topLeftCorner(4 * m, 4 * m);
+      check(MatSetValuesBlocked(matrix_, m, ids.data(), m, ids.data(), used.data(), ADD_VALUES),
+            "MatSetValuesBlocked");
+    };
+    for (std::size_t f = 0; f < mesh_.boundary_tris.size(); ++f)
+      if (mesh_.boundary_tri_patch[f] == backflow_patch_) face(mesh_.boundary_tris[f]);
+    for (std::size_t f = 0; f < mesh_.boundary_quads.size(); ++f)
+      if (mesh_.boundary_quad_patch[f] == backflow_patch_) face(mesh_.boundary_quads[f]);
+  }
+
   template <class E, class Cells, class Force>
   void assemble_cells(const Cells& cells, const std::vector<Eigen::Vector3d>& advection, double nu,
                       const Force& force) {
@@ -141,6 +193,8 @@ class OseenSystem {
   }
 
   const HybridMesh& mesh_;
+  int backflow_patch_ = -1;
+  double backflow_beta_ = 0.0;
   petsc::Matrix matrix_;
   petsc::Vector rhs_, solution_, residual_;
   std::vector<Eigen::Matrix<double, 1, 9>> gradient_;  // recovered ∇a per node
@@ -189,7 +243,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
     rows.push_back(4 * bc.pressure_pin->first + 3);
   }
 
-  OseenSystem system(mesh, options.options_prefix);
+  OseenSystem system(mesh, options.options_prefix, options.backflow_patch, options.backflow_beta);
   petsc::LinearSolver ksp;
   check(KSPCreate(PETSC_COMM_SELF, ksp.out()), "KSPCreate");
   check(KSPSetOptionsPrefix(ksp, options.options_prefix.c_str()), "KSPSetOptionsPrefix");

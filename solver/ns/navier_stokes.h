@@ -34,7 +34,10 @@ struct PicardOptions {
   double absolute_tolerance = 1e-13;
   double relaxation = 1.0;  // U ← U + ω (U* − U)
   std::string options_prefix = "ns_";
-  bool log_iterations = false;  // a line per Picard step (residual, relaxation, linear iterations)
+  bool log_iterations = false;
+  // Outflow stabilization on this patch (the outlet; −1: none) with coefficient β ∈ [0, 1].
+  int backflow_patch = -1;
+  double backflow_beta = 1.0;  // a line per Picard step (residual, relaxation, linear iterations)
 };
 
 struct PicardReport {
