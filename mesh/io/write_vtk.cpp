@@ -223,9 +223,23 @@ vtkSmartPointer<vtkPolyData> boundary_polydata(const HybridMesh& mesh, bool tria
 }
 }  // namespace
 
-void write_boundary_vtp(const HybridMesh& mesh, const std::filesystem::path& path) {
+void write_boundary_vtp(const HybridMesh& mesh, const std::filesystem::path& path,
+                        const PointFields& face_fields) {
+  auto poly = boundary_polydata(mesh, false);
+  const std::size_t faces = mesh.boundary_tris.size() + mesh.boundary_quads.size();
+  for (const auto& [name, field] : face_fields) {
+    if (field.values.size() != static_cast<std::size_t>(field.components) * faces)
+      fail("internal: face field '{}' has {} values for {} faces", name, field.values.size(),
+           faces);
+    auto array = vtkSmartPointer<vtkDoubleArray>::New();
+    array->SetName(name.c_str());
+    array->SetNumberOfComponents(field.components);
+    array->SetNumberOfTuples(static_cast<vtkIdType>(faces));
+    std::copy(field.values.begin(), field.values.end(), array->GetPointer(0));
+    poly->GetCellData()->AddArray(array);
+  }
   auto writer = vtkSmartPointer<vtkXMLPolyDataWriter>::New();
-  writer->SetInputData(boundary_polydata(mesh, false));
+  writer->SetInputData(poly);
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
   writer->SetCompressorTypeToNone();

@@ -21,7 +21,9 @@ using PointFields = std::map<std::string, PointField>;
 
 void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
                const CellFields& cell_fields = {}, const PointFields& point_fields = {});
-void write_boundary_vtp(const HybridMesh& mesh, const std::filesystem::path& path);
+// Face fields are given per boundary face: triangles, then quadrilaterals.
+void write_boundary_vtp(const HybridMesh& mesh, const std::filesystem::path& path,
+                        const PointFields& face_fields = {});
 void write_stl(const HybridMesh& mesh, const std::filesystem::path& path);
 
 }  // namespace naris

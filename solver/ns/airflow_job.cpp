@@ -12,6 +12,7 @@
 #include "io/mesh_h5.h"
 #include "io/write_vtk.h"
 #include "ns/solution_file.h"
+#include "ns/wall_stress.h"
 #include "patches/patches.h"
 #include "quality/check.h"
 
@@ -216,8 +217,28 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   r.resistance = r.pressure_drop_pa / r.flow_ml_s;
   for (const auto& v : last_good.velocity) r.max_speed = std::max(r.max_speed, v.norm() * u);
 
+  // Stresses on the boundary, while the geometry is still nondimensional.
+  const WallStress stress = wall_stress(mesh, last_good, reached);
+  const double force_scale = pscale * d_in * d_in;
+  for (const auto& p : stress.patches)
+    r.patches.push_back({p.name, p.area * r.d_in_mm * r.d_in_mm, p.pressure * force_scale,
+                         p.viscous * force_scale, p.mean_shear * pscale, p.max_shear * pscale});
+
   // Files, in millimetres again.
   for (auto& x : mesh.nodes) x *= r.d_in_mm;
+  {
+    PointFields faces;
+    PointField vec{3, {}}, mag{1, {}};
+    for (const auto& s : stress.shear) {
+      for (int c = 0; c < 3; ++c) vec.values.push_back(s[c] * pscale);
+      mag.values.push_back(s.norm() * pscale);
+    }
+    faces["wall_shear_stress"] = std::move(vec);
+    faces["wall_shear_stress_magnitude"] = std::move(mag);
+    const fs::path vtp = job.output / "boundary.vtp";
+    write_boundary_vtp(mesh, vtp, faces);
+    r.written.push_back(vtp.string());
+  }
   PointFields fields;
   auto vector_field = [&](double scale) {
     PointField f{3, {}};
@@ -269,6 +290,16 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
           "{:.6e}, \"seconds\": {:.3f}}}",
           steps.empty() ? "" : ", ", s.reynolds, s.converged ? "true" : "false", s.iterations,
           s.residual, s.seconds);
+    std::string patches;
+    for (const auto& p : r.patches)
+      patches += fmt::format(
+          "{}\n    {{\"name\": \"{}\", \"area_mm2\": {:.6g}, \"pressure_force_n\": [{:.6g}, "
+          "{:.6g}, "
+          "{:.6g}], \"viscous_force_n\": [{:.6g}, {:.6g}, {:.6g}], \"mean_wall_shear_pa\": {:.6g}, "
+          "\"max_wall_shear_pa\": {:.6g}}}",
+          patches.empty() ? "" : ",", p.name, p.area_mm2, p.pressure_force[0], p.pressure_force[1],
+          p.pressure_force[2], p.viscous_force[0], p.viscous_force[1], p.viscous_force[2],
+          p.mean_shear, p.max_shear);
     AtomicOutput out(json);
     std::ofstream f(out.temp_path());
     f << fmt::format(
@@ -279,14 +310,15 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
         "\"{}\",\n"
         "  \"flow_ml_s\": {:.6g},\n  \"outlet_flow_ml_s\": {:.6g},\n  \"pressure_drop_pa\": "
         "{:.6g},\n"
-        "  \"resistance_pa_s_ml\": {:.6g},\n  \"max_speed_m_s\": {:.6g},\n  \"continuation\": "
-        "[{}],\n"
+        "  \"resistance_pa_s_ml\": {:.6g},\n  \"max_speed_m_s\": {:.6g},\n  \"patches\": [{}\n  "
+        "],\n"
+        "  \"continuation\": [{}],\n"
         "  \"seconds\": {:.3f},\n  \"peak_memory_mb\": {:.1f}\n}}\n",
         job.mesh.string(), r.cells, r.nodes, r.reynolds, r.u_in, r.d_in_mm, r.inlet_area_mm2,
         r.inlet_perimeter_mm, job.viscosity, job.density,
         job.profile == InletProfile::uniform ? "uniform" : "developed", r.flow_ml_s,
-        r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance, r.max_speed, steps, r.seconds,
-        r.peak_memory / 1048576.0);
+        r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance, r.max_speed, patches, steps,
+        r.seconds, r.peak_memory / 1048576.0);
     if (!f) fail("{}: write failed", json.string());
     f.close();
     out.commit();
@@ -297,6 +329,9 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
 }
 
 std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r) {
+  AirflowResult::Patch wall;
+  for (const auto& p : r.patches)
+    if (p.name == "wall") wall = p;
   int picard = 0;
   for (const auto& s : r.steps) picard += s.iterations;
   return fmt::format(
@@ -306,13 +341,15 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
       "  flow      {:.2f} mL/s in, {:.2f} mL/s out\n"
       "  pressure  drop inlet→outlet {:.3f} Pa; resistance {:.4f} Pa·s/mL\n"
       "  speed     max {:.3f} m/s\n"
+      "  wall      shear stress mean {:.4f} Pa, max {:.4f} Pa; force {:.3e} N\n"
       "  solve     {} continuation steps, {} Picard steps, {:.1f} s, peak {:.0f} MB\n"
       "  wrote     {}",
       job.mesh.filename().string(), r.cells, r.nodes, r.inlet_area_mm2, r.inlet_perimeter_mm,
       r.d_in_mm, job.profile == InletProfile::uniform ? "uniform" : "developed", r.reynolds, r.u_in,
       job.viscosity, job.density, r.flow_ml_s, r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance,
-      r.max_speed, r.steps.size(), picard, r.seconds, r.peak_memory / 1048576.0,
-      fmt::join(r.written, "\n            "));
+      r.max_speed, wall.mean_shear, wall.max_shear,
+      (wall.pressure_force + wall.viscous_force).norm(), r.steps.size(), picard, r.seconds,
+      r.peak_memory / 1048576.0, fmt::join(r.written, "\n            "));
 }
 
 }  // namespace naris::ns

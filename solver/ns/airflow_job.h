@@ -41,6 +41,14 @@ struct AirflowResult {
   double u_in = 0.0, reynolds = 0.0;
   double flow_ml_s = 0.0, pressure_drop_pa = 0.0, resistance = 0.0, max_speed = 0.0;
   double outlet_flow_ml_s = 0.0;  // mass balance check
+  struct Patch {
+    std::string name;
+    double area_mm2 = 0.0;
+    Eigen::Vector3d pressure_force = Eigen::Vector3d::Zero(),
+                    viscous_force = Eigen::Vector3d::Zero();
+    double mean_shear = 0.0, max_shear = 0.0;  // Pa
+  };
+  std::vector<Patch> patches;  // forces (N) and wall shear stress per patch
   std::vector<ContinuationStep> steps;
   std::size_t cells = 0, nodes = 0;
   double seconds = 0.0, restarted_from = 0.0;  // the checkpoint's Re, 0 without --restart

@@ -13,6 +13,7 @@
 #include "meshes.h"
 #include "ns/boundary_conditions.h"
 #include "ns/navier_stokes.h"
+#include "ns/wall_stress.h"
 
 namespace naris::ns {
 namespace {
@@ -82,6 +83,29 @@ void check_poiseuille(double re) {
       in, out);
   EXPECT_NEAR(gradient, hagen_poiseuille, 0.02 * hagen_poiseuille);
   EXPECT_NEAR(u_max, 2 * u_mean, 0.02 * 2 * u_mean);
+  // Wall shear stress 4νŪ/R: the cell gradient next to the wall is a secant of the parabola,
+  // first order in h (at h = R/10 about 5 % low), so this checks magnitude and direction.
+  const WallStress stress = wall_stress(mesh, f, re);
+  const int wall = mesh.patch_id("wall");
+  double shear = 0, shear_area = 0, axial = 0;
+  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t) {
+    if (mesh.boundary_tri_patch[t] != wall) continue;
+    const auto& v = mesh.boundary_tris[t];
+    const Eigen::Vector3d c = (mesh.nodes[v[0]] + mesh.nodes[v[1]] + mesh.nodes[v[2]]) / 3.0;
+    if (c[2] < 1.0 || c[2] > 3.0) continue;
+    const double a =
+        0.5 *
+        (mesh.nodes[v[1]] - mesh.nodes[v[0]]).cross(mesh.nodes[v[2]] - mesh.nodes[v[0]]).norm();
+    shear += a * stress.shear[t].norm();
+    axial += a * stress.shear[t][2];
+    shear_area += a;
+  }
+  const double tau = shear / shear_area,
+               exact_tau = 4.0 * nu * u_mean / std::sqrt(area / std::numbers::pi);
+  std::printf("[ info ] Re %g: wall shear %.5f vs 4 nu U/R %.5f (%.2f%%)\n", re, tau, exact_tau,
+              100 * (tau / exact_tau - 1));
+  EXPECT_NEAR(tau, exact_tau, 0.06 * exact_tau);
+  EXPECT_GT(axial / shear_area, 0.99 * tau);  // along the flow
   EXPECT_NEAR(out, in, 1e-6 * in);
   EXPECT_NEAR(in, q, 1e-9 * q);
 }
