@@ -266,10 +266,11 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
   bool stokes = initial == nullptr;
   // Damped Picard: the update U ← U + ω (U* − U) starts at the given relaxation; when the
   // residual grows, ω is halved and the step retaken from the previous iterate (no new solve);
-  // after a step that halves the residual ω grows back towards the given value.
+  // after a step that halves the residual, or three steps that lower it, ω grows back towards
+  // the given value.
   double omega = options.relaxation, previous_norm = INFINITY;
   FlowField previous, target;  // the iterate a step started from, and the solve's answer
-  int solves = 0;
+  int solves = 0, decreasing = 0;
   for (int it = 0; solves <= options.max_iterations + 1 && it < 4 * options.max_iterations + 8;
        ++it) {
     from_field(field, current);
@@ -307,7 +308,12 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
       }
       if (!std::isfinite(norm)) fail("the nonlinear iteration diverged (residual {})", norm);
       r.residuals.push_back(norm);
-      if (norm < 0.5 * previous_norm) omega = std::min(options.relaxation, 2.0 * omega);
+      // Grow ω back after a halving of the residual or three decreasing steps in a row.
+      decreasing = norm < previous_norm ? decreasing + 1 : 0;
+      if (norm < 0.5 * previous_norm || decreasing >= 3) {
+        omega = std::min(options.relaxation, 2.0 * omega);
+        decreasing = 0;
+      }
       previous_norm = norm;
       if (solves > options.max_iterations) break;
     }
