@@ -7,6 +7,30 @@ void check(herr_t status, const fs::path& path, const char* what) {
   if (status < 0) fail("{}: HDF5 failed to {}", path.string(), what);
 }
 
+H5Handle create_file(const fs::path& temp, const fs::path& path, const std::string& format,
+                     int version) {
+  H5Handle file(H5Fcreate(temp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+  if (!file.valid()) fail("{}: cannot create the HDF5 file", path.string());
+  write_string_attribute(file.get(), "format", format, path);
+  write_string_attribute(file.get(), "version", std::to_string(version), path);
+  return file;
+}
+
+H5Handle open_file(const fs::path& path, const std::string& format, int version, const char* kind) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) fail("{}: no such file (expected {})", path.string(), kind);
+  if (H5Fis_hdf5(path.c_str()) <= 0) fail("{}: not an HDF5 file", path.string());
+  H5Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!file.valid()) fail("{}: cannot open the HDF5 file (corrupt?)", path.string());
+  if (read_string_attribute(file.get(), "format", path, kind) != format)
+    fail("{}: not {}", path.string(), kind);
+  const std::string found = read_string_attribute(file.get(), "version", path, kind);
+  if (found != std::to_string(version))
+    fail("{}: format version {} is not supported (this naris reads version {})", path.string(),
+         found, version);
+  return file;
+}
+
 H5Handle make_group(hid_t parent, const char* name, const fs::path& path) {
   H5Handle g(H5Gcreate2(parent, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
   if (!g.valid()) fail("{}: cannot create group {}", path.string(), name);

@@ -24,6 +24,14 @@ struct SilenceHdf5 {
 };
 
 void check(herr_t status, const std::filesystem::path& path, const char* what);
+// A new file at `temp` (an AtomicOutput's temporary) for `path`, stamped with the attributes
+// format and version that open_file checks.
+H5Handle create_file(const std::filesystem::path& temp, const std::filesystem::path& path,
+                     const std::string& format, int version);
+// An existing naris file of the given format and version, read-only; `kind` names it in errors
+// ("a naris mesh file").
+H5Handle open_file(const std::filesystem::path& path, const std::string& format, int version,
+                   const char* kind);
 H5Handle make_group(hid_t parent, const char* name, const std::filesystem::path& path);
 // A 2D dataset [rows, cols] (1D when cols is 1), chunked so that large arrays stream.
 void write_table(hid_t parent, const char* name, hid_t mem_type, hid_t file_type, const void* data,

@@ -65,12 +65,8 @@ void write_mesh_h5(const HybridMesh& mesh, const fs::path& path) {
   SilenceHdf5 quiet;
   {
     AtomicOutput out(path);
-    H5Handle file(H5Fcreate(out.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
-                  H5Fclose);
-    if (!file.valid()) fail("{}: cannot create the HDF5 file", path.string());
-    write_string_attribute(file.get(), "format", "naris-mesh", path);
+    H5Handle file = create_file(out.temp_path(), path, "naris-mesh", kFormatVersion);
     write_string_attribute(file.get(), "units", "mm", path);
-    write_string_attribute(file.get(), "version", std::to_string(kFormatVersion), path);
     std::string names;
     for (const auto& n : mesh.patch_names) names += (names.empty() ? "" : "\n") + n;
     write_string_attribute(file.get(), "patch_names", names, path);
@@ -104,18 +100,7 @@ void write_mesh_h5(const HybridMesh& mesh, const fs::path& path) {
 
 HybridMesh read_mesh_h5(const fs::path& path) {
   SilenceHdf5 quiet;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) fail("{}: no such mesh file", path.string());
-  if (H5Fis_hdf5(path.c_str()) <= 0) fail("{}: not an HDF5 file", path.string());
-  H5Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-  if (!file.valid()) fail("{}: cannot open the HDF5 file (corrupt?)", path.string());
-  if (read_string_attribute(file.get(), "format", path, "a naris mesh file") != "naris-mesh")
-    fail("{}: not a naris mesh file", path.string());
-  const std::string version =
-      read_string_attribute(file.get(), "version", path, "a naris mesh file");
-  if (version != std::to_string(kFormatVersion))
-    fail("{}: mesh format version {} is not supported (this naris reads version {})", path.string(),
-         version, kFormatVersion);
+  const H5Handle file = open_file(path, "naris-mesh", kFormatVersion, "a naris mesh file");
   HybridMesh mesh;
   std::istringstream names(
       read_string_attribute(file.get(), "patch_names", path, "a naris mesh file"));

@@ -102,11 +102,7 @@ void write_solution_h5(const SolutionState& s, const fs::path& path, const Hybri
   SilenceHdf5 quiet;
   {
     AtomicOutput out(path);
-    H5Handle file(H5Fcreate(out.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
-                  H5Fclose);
-    if (!file.valid()) fail("{}: cannot create the HDF5 file", path.string());
-    write_string_attribute(file.get(), "format", "naris-solution", path);
-    write_string_attribute(file.get(), "version", std::to_string(kVersion), path);
+    H5Handle file = create_file(out.temp_path(), path, "naris-solution", kVersion);
     write_string_attribute(file.get(), "mesh_fingerprint",
                            fmt::format("{:016x}", s.mesh_fingerprint), path);
     attribute(file.get(), "nodes", static_cast<double>(s.field.pressure.size()), path);
@@ -130,16 +126,7 @@ void write_solution_h5(const SolutionState& s, const fs::path& path, const Hybri
 
 SolutionState read_solution_h5(const fs::path& path) {
   SilenceHdf5 quiet;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) fail("{}: no such solution or checkpoint file", path.string());
-  if (H5Fis_hdf5(path.c_str()) <= 0) fail("{}: not an HDF5 file", path.string());
-  H5Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-  if (!file.valid()) fail("{}: cannot open the HDF5 file (corrupt?)", path.string());
-  if (read_string_attribute(file.get(), "format", path, kKind) != "naris-solution")
-    fail("{}: not {}", path.string(), kKind);
-  if (read_string_attribute(file.get(), "version", path, kKind) != std::to_string(kVersion))
-    fail("{}: solution format version not supported (this naris reads version {})", path.string(),
-         kVersion);
+  const H5Handle file = open_file(path, "naris-solution", kVersion, kKind);
   SolutionState s;
   s.mesh_fingerprint =
       std::stoull(read_string_attribute(file.get(), "mesh_fingerprint", path, kKind), nullptr, 16);
