@@ -112,26 +112,25 @@ struct Section {
 
 NasalPhantom::NasalPhantom(int subject) : subject_(subject) {
   if (subject < 1) fail("phantom subject {} is not valid: subjects are numbered from 1", subject);
-  for (double& b : branch_scale_) b = 1.0;
-  meatus_width_scale_ = 1.0;
-  septal_bulge_ = 0.0;
   if (subject > 1) {
     // Deterministic per subject, and independent of the platform's distributions.
     std::mt19937_64 rng(0x9E3779B97F4A7C15ull * static_cast<unsigned>(subject));
     auto uniform = [&rng](double lo, double hi) {
       return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
     };
-    for (double& b : branch_scale_) b = uniform(0.75, 1.25);
-    meatus_width_scale_ = uniform(0.85, 1.15);
-    septal_bulge_ = uniform(0.2, 1.0);
+    for (double& b : variation_.branch_scale) b = uniform(0.75, 1.25);
+    variation_.meatus_width_scale = uniform(0.85, 1.15);
+    variation_.septal_bulge = uniform(0.2, 1.0);
   }
-  if (subject == 3) obstruction_ = 0.3;
+  if (subject == 3) variation_.obstruction = 0.3;
 }
 
 namespace {
 
-Section make_section(const Keyframe& k, const double (&branch_scale)[3], double width_scale,
-                     double bulge, double obstruction) {
+// The section of a subject at depth s.
+Section section_of(const NasalPhantom::Variation& v, double s) {
+  const Keyframe k = keyframe_at(s);
+  const double bulge = v.septal_bulge, obstruction = v.obstruction;
   Section sec;
   sec.common = {k.uc, k.hb, k.uc, k.ht, k.rc};
   if (bulge > 0.0) {
@@ -143,9 +142,9 @@ Section make_section(const Keyframe& k, const double (&branch_scale)[3], double 
     sec.capsules[sec.count++] = {k.uc, k.ht, k.uc, k.ht + k.olf + k.rc, kOlfactoryRadius};
   double below_top = 0.0;  // the highest air of the branch below
   for (int b = 0; b < 3; ++b) {
-    const double len = k.len[b] * branch_scale[b];
+    const double len = k.len[b] * v.branch_scale[b];
     if (len <= 0.05) continue;
-    double rm = k.rm * width_scale;
+    double rm = k.rm * v.meatus_width_scale;
     if (b == 1 && obstruction < 1.0) {
       // A partial obstruction of the middle meatus (like study 3), over 50 … 70 mm.
       const double w =
@@ -156,7 +155,7 @@ Section make_section(const Keyframe& k, const double (&branch_scale)[3], double 
     rm = std::min(rm, 0.5 * len + 0.2);
     const double h = k.hb + kBranchAttach[b] * (k.ht - k.hb);
     const double ue = k.uc + len, he = h + 0.2 * len;
-    double drop = k.drop[b] * branch_scale[b];
+    double drop = k.drop[b] * v.branch_scale[b];
     // The meatus runs down the lateral wall but stops 2 mm of tissue short of the branch below
     // (the inferior one at the floor): a turbinate stays attached to the lateral wall, never an
     // island.
@@ -168,26 +167,25 @@ Section make_section(const Keyframe& k, const double (&branch_scale)[3], double 
   return sec;
 }
 
-}  // namespace
-
-double NasalPhantom::section_field(double u, double h, double s) const {
-  return make_section(keyframe_at(s), branch_scale_, meatus_width_scale_, septal_bulge_,
-                      obstruction_)
-      .field(u, h);
-}
-
-bool NasalPhantom::in_airway(const Eigen::Vector3d& x) const {
-  return section_field(-x[0], x[2], x[1]) < 0.0;
-}
-
-double NasalPhantom::hounsfield(double u, double h, double s) const {
-  const double f = section_field(u, h, s);
+// Hounsfield value at (u, h) of a section at depth s (no noise, no partial volume).
+double hounsfield(const Section& sec, double u, double h, double s) {
+  const double f = sec.field(u, h);
   if (f < 0.0) return kHuAir;
   // A bony shell 1 … 2.2 mm from the airway (turbinate cores, lateral wall, septum) behind the
   // cartilaginous vestibule; soft tissue and mucosa elsewhere.
   const double bone_weight = smoothstep(std::clamp((s - 16.0) / 6.0, 0.0, 1.0));
   if (f >= 1.0 && f < 2.2) return kHuSoft + bone_weight * (kHuBone - kHuSoft);
   return kHuSoft;
+}
+
+}  // namespace
+
+double NasalPhantom::section_field(double u, double h, double s) const {
+  return section_of(variation_, s).field(u, h);
+}
+
+bool NasalPhantom::in_airway(const Eigen::Vector3d& x) const {
+  return section_field(-x[0], x[2], x[1]) < 0.0;
 }
 
 ImageFrame NasalPhantom::frame(double pixel, double slice) const {
@@ -211,8 +209,7 @@ Eigen::Vector3d NasalPhantom::seed_point() const {
 
 std::array<double, 2> NasalPhantom::section_area_perimeter(double s, double step) const {
   if (!(step > 0.0)) fail("section sampling step must be positive");
-  const Section sec =
-      make_section(keyframe_at(s), branch_scale_, meatus_width_scale_, septal_bulge_, obstruction_);
+  const Section sec = section_of(variation_, s);
   // Sample only the capsules' bounding box (with a margin of two steps): the rest is tissue.
   double u0 = std::min(sec.common.ax, sec.common.bx) - sec.common.r;
   double u1 = std::max(sec.common.ax, sec.common.bx) + sec.common.r;
@@ -284,6 +281,7 @@ Volume<float> render_phantom_ct(const NasalPhantom& phantom, const PhantomSampli
     for (int q = 0; q < ss; ++q) {
       // Rectangular slice profile: samples at the centres of ss equal parts of the thickness.
       const double s = slice * (k + (q + 0.5) / ss - 0.5);
+      const Section sec = section_of(phantom.variation(), s);  // the same for the whole plane
       for (int j = 0; j < nj; ++j)
         for (int i = 0; i < ni; ++i) {
           double acc = 0.0;
@@ -291,7 +289,7 @@ Volume<float> render_phantom_ct(const NasalPhantom& phantom, const PhantomSampli
             for (int a = 0; a < sub; ++a) {
               const double u = kU0 + pixel * (i + (a + 0.5) / sub - 0.5);
               const double h = kH0 + pixel * (j + (b + 0.5) / sub - 0.5);
-              acc += phantom.hounsfield(u, h, s);
+              acc += hounsfield(sec, u, h, s);
             }
           sum[static_cast<std::size_t>(j) * ni + i] += acc;
         }
@@ -326,9 +324,7 @@ Volume<std::uint8_t> phantom_mask(const NasalPhantom& phantom, const ImageFrame&
         const Eigen::Vector3d x = grid.physical(Eigen::Vector3d(i, j, k));
         if (x[1] != cached_s) {
           cached_s = x[1];
-          section =
-              make_section(keyframe_at(x[1]), phantom.branch_scale_, phantom.meatus_width_scale_,
-                           phantom.septal_bulge_, phantom.obstruction_);
+          section = section_of(phantom.variation(), x[1]);
         }
         mask.at(i, j, k) = section.field(-x[0], x[2]) < 0.0 ? 1 : 0;
       }

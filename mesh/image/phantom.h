@@ -52,18 +52,20 @@ class NasalPhantom {
   // given step (marching squares).
   std::array<double, 2> section_area_perimeter(double s, double step = 0.02) const;
 
-  // Hounsfield value of the tissue at a point (no noise, no partial volume).
-  double hounsfield(double u, double h, double s) const;
-
   struct Keyframe;  // the parameters of the section at one depth (defined in phantom.cpp)
 
+  // How this subject departs from the reference anatomy (subject 1: not at all).
+  struct Variation {
+    double branch_scale[3] = {1.0, 1.0, 1.0};  // inferior, middle, superior meatus lengths
+    double meatus_width_scale = 1.0;
+    double septal_bulge = 0.0;  // mm into the common meatus
+    double obstruction = 1.0;   // middle meatus radius factor between s = 50 and 70
+  };
+  const Variation& variation() const { return variation_; }
+
  private:
-  friend Volume<std::uint8_t> phantom_mask(const NasalPhantom& phantom, const ImageFrame& grid);
   int subject_;
-  double branch_scale_[3];
-  double meatus_width_scale_;
-  double septal_bulge_;       // mm into the common meatus
-  double obstruction_ = 1.0;  // middle meatus radius factor between s = 50 and 70
+  Variation variation_;
 };
 
 // The CT scan of the phantom (HU, float) sampled as described above; threads over slices.
