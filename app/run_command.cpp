@@ -275,12 +275,7 @@ void run_case(const RunOptions& o) {
                          oc.ran ? fmt::format("{:.2f} s", oc.seconds) : "-", oc.output.string());
   if (phantom_subject && !airway.empty()) {
     // The phantom knows its exact airway: score the segmentation on its own grid.
-    const Volume<float> a = read_volume(airway);
-    Volume<std::uint8_t> mask;
-    mask.frame = a.frame;
-    mask.values.resize(a.values.size());
-    std::transform(a.values.begin(), a.values.end(), mask.values.begin(),
-                   [](float x) { return static_cast<std::uint8_t>(x > 0.5f); });
+    const Volume<std::uint8_t> mask = to_mask(read_volume(airway));
     const double d = dice(mask, phantom_mask(NasalPhantom(*phantom_subject), mask.frame));
     table += fmt::format("  segmentation vs the phantom's exact airway: Dice {:.4f}\n", d);
   }

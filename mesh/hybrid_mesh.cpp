@@ -16,11 +16,15 @@ int HybridMesh::add_patch(const std::string& name) {
   return static_cast<int>(patch_names.size()) - 1;
 }
 
-double polygon_area(const HybridMesh& m, std::span<const NodeId> nodes) {
+Eigen::Vector3d polygon_vector_area(const HybridMesh& m, std::span<const NodeId> nodes) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < nodes.size(); ++i)
     sum += m.nodes[nodes[i]].cross(m.nodes[nodes[(i + 1) % nodes.size()]]);
-  return 0.5 * sum.norm();
+  return 0.5 * sum;
+}
+
+double polygon_area(const HybridMesh& m, std::span<const NodeId> nodes) {
+  return polygon_vector_area(m, nodes).norm();
 }
 
 double tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,

@@ -74,6 +74,9 @@ void for_each_boundary_face(const HybridMesh& m, F&& f) {
     f(std::span<const NodeId>(m.boundary_quads[i]), m.boundary_quad_patch[i]);
 }
 
+// Vector area ½ Σ xᵢ × xᵢ₊₁ of a polygon (along its right-hand normal); for a planar polygon
+// its norm is the area, and it equals the sum over any fan triangulation.
+Eigen::Vector3d polygon_vector_area(const HybridMesh& m, std::span<const NodeId> nodes);
 // Area of a planar (or nearly planar) polygon: half the norm of its vector area.
 double polygon_area(const HybridMesh& m, std::span<const NodeId> nodes);
 

@@ -62,8 +62,7 @@ Volume<float> interpolate_slices(const Volume<float>& v, int axis, int k, SliceM
   if (k < 0) fail("the number of slices to insert must not be negative");
   const int n = v.dims()[axis];
   if (n < 2) fail("a volume with a single slice along axis {} cannot be interpolated", axis);
-  const bool mask =
-      std::all_of(v.values.begin(), v.values.end(), [](float x) { return x == 0.0f || x == 1.0f; });
+  const bool mask = is_binary(v);
   Volume<float> out;
   out.frame = v.frame;
   out.frame.dims[axis] = (n - 1) * (k + 1) + 1;

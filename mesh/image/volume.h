@@ -3,6 +3,7 @@
 // Index ↔ physical conversion lives here and nowhere else. Physical coordinates are patient
 // LPS millimetres (DICOM's and 3D Slicer's convention); readers of RAS formats convert.
 #include <Eigen/Dense>
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -47,5 +48,21 @@ struct Volume {
     return {values.data() + n * static_cast<std::size_t>(k), n};
   }
 };
+
+// True when every value is 0 or 1: a labelmap read as floats.
+inline bool is_binary(const Volume<float>& v) {
+  return std::all_of(v.values.begin(), v.values.end(),
+                     [](float x) { return x == 0.0f || x == 1.0f; });
+}
+
+// The 0/1 mask of the voxels above one half, on the same frame.
+inline Volume<std::uint8_t> to_mask(const Volume<float>& v) {
+  Volume<std::uint8_t> m;
+  m.frame = v.frame;
+  m.values.resize(v.values.size());
+  std::transform(v.values.begin(), v.values.end(), m.values.begin(),
+                 [](float x) { return static_cast<std::uint8_t>(x > 0.5f); });
+  return m;
+}
 
 }  // namespace naris

@@ -87,14 +87,11 @@ InterpolateJobResult run_interpolate_job(const InterpolateJob& job) {
     fail("{}: a single slice along {} cannot be interpolated; a volume needs at least two",
          job.input.string(), "ijk"[r.axis]);
   const double h = v.frame.spacing[r.axis];
-  r.inserted = job.insert    ? *job.insert
-               : job.spacing ? std::max(0, static_cast<int>(std::lround(h / *job.spacing)) - 1)
-                             : std::max(0, static_cast<int>(std::lround(
-                                               h / std::min({v.frame.spacing[0], v.frame.spacing[1],
-                                                             v.frame.spacing[2]}))) -
-                                               1);
-  r.mask =
-      std::all_of(v.values.begin(), v.values.end(), [](float x) { return x == 0.0f || x == 1.0f; });
+  // By default down to the finest spacing: isotropic voxels when the plane is square.
+  const double target = job.spacing ? *job.spacing : v.frame.spacing.minCoeff();
+  r.inserted =
+      job.insert ? *job.insert : std::max(0, static_cast<int>(std::lround(h / target)) - 1);
+  r.mask = is_binary(v);
   if (job.method == SliceMethod::shape && !r.mask) {
     // Shape-based interpolation blends distance maps of segmented slices: the gray values are
     // segmented first at the air threshold, and the result is an airway labelmap.
@@ -106,12 +103,7 @@ InterpolateJobResult run_interpolate_job(const InterpolateJob& job) {
       interpolate_slices(v, r.axis, r.inserted, job.method, job.hsr, job.threads);
   r.after = out.frame;
   if (r.mask) {
-    Volume<std::uint8_t> m;
-    m.frame = out.frame;
-    m.values.resize(out.values.size());
-    std::transform(out.values.begin(), out.values.end(), m.values.begin(),
-                   [](float x) { return static_cast<std::uint8_t>(x > 0.5f); });
-    write_labelmap_nrrd(m, job.output);
+    write_labelmap_nrrd(to_mask(out), job.output);
   } else {
     write_ct_nrrd(out, job.output);
   }
@@ -142,8 +134,7 @@ SegmentJobResult run_segment_job(const SegmentJob& job) {
   r.format = info.format;
   // A labelmap (from shape-based interpolation, or a segmentation to clean up) is grown from
   // the seeds as it is: its airway is the label 1.
-  const bool labelmap = std::all_of(ct.values.begin(), ct.values.end(),
-                                    [](float x) { return x == 0.0f || x == 1.0f; });
+  const bool labelmap = is_binary(ct);
   bool inside_above = job.inside_above;
   if (job.decimate > 1) ct = decimate_in_plane(ct, job.decimate);
   if (!job.rotate.empty()) {

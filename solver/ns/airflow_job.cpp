@@ -11,6 +11,7 @@
 #include "io/atomic_file.h"
 #include "io/mesh_h5.h"
 #include "io/write_vtk.h"
+#include "ns/patch_integrals.h"
 #include "ns/solution_file.h"
 #include "ns/wall_stress.h"
 #include "patches/patches.h"
@@ -20,47 +21,6 @@ namespace naris::ns {
 namespace fs = std::filesystem;
 
 namespace {
-
-// Area-weighted mean of the nodal pressure over a patch (its faces' corner average).
-double patch_mean(const HybridMesh& mesh, const std::vector<double>& p, int patch) {
-  double sum = 0.0, area = 0.0;
-  auto face = [&](std::span<const NodeId> v) {
-    Eigen::Vector3d an = Eigen::Vector3d::Zero();
-    for (std::size_t k = 1; k + 1 < v.size(); ++k)
-      an += 0.5 *
-            (mesh.nodes[v[k]] - mesh.nodes[v[0]]).cross(mesh.nodes[v[k + 1]] - mesh.nodes[v[0]]);
-    double mean = 0.0;
-    for (NodeId n : v) mean += p[static_cast<std::size_t>(n)];
-    sum += an.norm() * mean / static_cast<double>(v.size());
-    area += an.norm();
-  };
-  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t)
-    if (mesh.boundary_tri_patch[t] == patch) face(mesh.boundary_tris[t]);
-  for (std::size_t q = 0; q < mesh.boundary_quads.size(); ++q)
-    if (mesh.boundary_quad_patch[q] == patch) face(mesh.boundary_quads[q]);
-  return area > 0.0 ? sum / area : 0.0;
-}
-
-// ∫ u·n dA over a patch, outward.
-double patch_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u, int patch) {
-  double flux = 0.0;
-  auto face = [&](std::span<const NodeId> v) {
-    if (v.size() == 3) {
-      const Eigen::Vector3d an =
-          0.5 * (mesh.nodes[v[1]] - mesh.nodes[v[0]]).cross(mesh.nodes[v[2]] - mesh.nodes[v[0]]);
-      flux += an.dot(u[v[0]] + u[v[1]] + u[v[2]]) / 3.0;
-    } else {
-      const Eigen::Vector3d an =
-          0.5 * (mesh.nodes[v[2]] - mesh.nodes[v[0]]).cross(mesh.nodes[v[3]] - mesh.nodes[v[1]]);
-      flux += an.dot(u[v[0]] + u[v[1]] + u[v[2]] + u[v[3]]) / 4.0;
-    }
-  };
-  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t)
-    if (mesh.boundary_tri_patch[t] == patch) face(mesh.boundary_tris[t]);
-  for (std::size_t q = 0; q < mesh.boundary_quads.size(); ++q)
-    if (mesh.boundary_quad_patch[q] == patch) face(mesh.boundary_quads[q]);
-  return flux;
-}
 
 void check_job(const AirflowJob& job) {
   if (!(job.reynolds > 0.0) || !std::isfinite(job.reynolds))
@@ -132,13 +92,12 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
 
   // Reynolds-number continuation: each step warm-started from the last converged one; the
   // step grows after an easy step and is halved after a failed one.
+  // `reached` is the last converged Re (0: none yet); `last_good` its field.
   FlowField field, last_good;
-  bool have_solution = false;
   double re = std::min(job.start_reynolds, r.reynolds), step = re;
   double reached = 0.0;
   if (resume) {
     last_good = resume->field;
-    have_solution = true;
     reached = resume->reynolds;
     step = std::max(reached, 1.0);
     re = std::min(r.reynolds, reached + step);
@@ -157,16 +116,16 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     s.mesh_fingerprint = fingerprint;
     return s;
   };
+  PicardOptions picard = job.picard;
+  picard.backflow_patch = outlet;
   for (int s = 0; s < job.max_steps && reached < r.reynolds; ++s) {
     ContinuationStep cs;
     cs.reynolds = re;
     Stopwatch clock;
     PicardReport report;
     try {
-      PicardOptions picard = job.picard;
-      picard.backflow_patch = outlet;
       field = solve_navier_stokes(mesh, 1.0 / re, {}, bc, picard, &report,
-                                  have_solution ? &last_good : nullptr);
+                                  reached > 0.0 ? &last_good : nullptr);
       cs.converged = report.converged;
     } catch (const Error& e) {
       cs.converged = false;  // a diverged iteration: treated as a failed step
@@ -182,14 +141,12 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
                          cs.seconds));
     if (cs.converged) {
       last_good = field;
-      have_solution = true;
       reached = re;
       write_solution_h5(state_at(re), checkpoint);  // the last good step, always on disk
-      if (re >= r.reynolds) break;
       if (cs.iterations < job.picard.max_iterations / 3) step *= 1.5;
       re = std::min(r.reynolds, re + step);
     } else {
-      if (!have_solution)
+      if (reached == 0.0)
         step = re *= 0.5;  // the very first step: start lower
       else {
         step *= 0.5;
@@ -198,7 +155,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       if (step < 1e-3 * r.reynolds)
         fail("the continuation stalled at Re {:.1f} (target {:.1f}): the step fell below {:.2f}{}",
              reached, r.reynolds, 1e-3 * r.reynolds,
-             have_solution ? "; " + checkpoint.string() + " holds the last converged step" : "");
+             reached > 0.0 ? "; " + checkpoint.string() + " holds the last converged step" : "");
     }
   }
   if (reached < r.reynolds)

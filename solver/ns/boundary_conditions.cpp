@@ -46,10 +46,7 @@ InletGeometry inlet_geometry(const HybridMesh& mesh) {
       moment += an.norm() * (a + b + c) / 3.0;
     }
   };
-  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t)
-    visit(mesh.boundary_tris[t], mesh.boundary_tri_patch[t]);
-  for (std::size_t q = 0; q < mesh.boundary_quads.size(); ++q)
-    visit(mesh.boundary_quads[q], mesh.boundary_quad_patch[q]);
+  for_each_boundary_face(mesh, visit);
   if (g.faces.empty()) fail("the 'inlet' patch has no faces");
   if (!has_outlet) fail("the 'outlet' patch has no faces");
   g.summary.area = area_normal.norm();

@@ -73,11 +73,8 @@ WallStress wall_stress(const HybridMesh& mesh, const FlowField& flow, double rey
         for (int i = 0; i < face.size; ++i) xi += E::node(face.v[i]) / face.size;
         const auto m = fem::map_to_cell<E>(X, E::shape(xi));
         const Eigen::Matrix3d grad = U.transpose() * m.gradient;  // grad(c, d) = ∂u_c/∂x_d
-        Eigen::Vector3d an = Eigen::Vector3d::Zero();
-        for (int k = 1; k + 1 < face.size; ++k)
-          an += 0.5 * (X.row(face.v[k]) - X.row(face.v[0]))
-                          .cross(X.row(face.v[k + 1]) - X.row(face.v[0]))
-                          .transpose();
+        const Eigen::Vector3d an =
+            polygon_vector_area(mesh, std::span<const NodeId>(v.data(), face.size));
         const double area = an.norm();
         const Eigen::Vector3d n = area > 0 ? Eigen::Vector3d(an / area) : Eigen::Vector3d::Zero();
         // The fluid's pull on the boundary: minus the viscous traction σn on the fluid.

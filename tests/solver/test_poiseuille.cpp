@@ -13,6 +13,7 @@
 #include "meshes.h"
 #include "ns/boundary_conditions.h"
 #include "ns/navier_stokes.h"
+#include "ns/patch_integrals.h"
 #include "ns/wall_stress.h"
 
 namespace naris::ns {
@@ -28,30 +29,6 @@ HybridMesh pipe(double length) {
   return testing::mve_mesh_box(
       [](const Eigen::Vector3d& x) { return 0.5 - std::hypot(x[0] - 0.013, x[1] + 0.007); },
       {-0.6, -0.6, 0.0}, {0.6, 0.6, length}, h, options);
-}
-
-// Flux through the patch: Σ over its faces of ∫ u·n dA (outward normal).
-double patch_flux(const HybridMesh& mesh, const FlowField& f, const std::string& name) {
-  const int id = mesh.patch_id(name);
-  double flux = 0.0;
-  auto tri = [&](NodeId a, NodeId b, NodeId c) {
-    const Eigen::Vector3d an =
-        0.5 * (mesh.nodes[b] - mesh.nodes[a]).cross(mesh.nodes[c] - mesh.nodes[a]);
-    flux += an.dot(f.velocity[a] + f.velocity[b] + f.velocity[c]) / 3.0;
-  };
-  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t)
-    if (mesh.boundary_tri_patch[t] == id)
-      tri(mesh.boundary_tris[t][0], mesh.boundary_tris[t][1], mesh.boundary_tris[t][2]);
-  // Planar quads: the bilinear field's flux is the area times the mean of its corners.
-  for (std::size_t q = 0; q < mesh.boundary_quads.size(); ++q)
-    if (mesh.boundary_quad_patch[q] == id) {
-      const auto& v = mesh.boundary_quads[q];
-      const Eigen::Vector3d an =
-          0.5 * (mesh.nodes[v[2]] - mesh.nodes[v[0]]).cross(mesh.nodes[v[3]] - mesh.nodes[v[1]]);
-      flux +=
-          an.dot(f.velocity[v[0]] + f.velocity[v[1]] + f.velocity[v[2]] + f.velocity[v[3]]) / 4.0;
-    }
-  return flux;
 }
 
 void check_poiseuille(double re) {
@@ -74,7 +51,8 @@ void check_poiseuille(double re) {
   const double gradient = -(n * szp - sz * sp) / (n * szz - sz * sz);
   const double hagen_poiseuille = 8.0 * std::numbers::pi * nu * q / (area * area);
   const double u_max = centre / centre_n, u_mean = q / area;
-  const double in = -patch_flux(mesh, f, "inlet"), out = patch_flux(mesh, f, "outlet");
+  const double in = -patch_flux(mesh, f.velocity, mesh.patch_id("inlet"));
+  const double out = patch_flux(mesh, f.velocity, mesh.patch_id("outlet"));
   std::printf(
       "[ info ] Re %g: %zu cells, %d Picard steps; -dp/dz %.5f vs Hagen-Poiseuille %.5f (%.2f%%); "
       "centreline %.4f vs 2 x mean %.4f (%.2f%%); flux in %.8f out %.8f\n",
@@ -93,9 +71,7 @@ void check_poiseuille(double re) {
     const auto& v = mesh.boundary_tris[t];
     const Eigen::Vector3d c = (mesh.nodes[v[0]] + mesh.nodes[v[1]] + mesh.nodes[v[2]]) / 3.0;
     if (c[2] < 1.0 || c[2] > 3.0) continue;
-    const double a =
-        0.5 *
-        (mesh.nodes[v[1]] - mesh.nodes[v[0]]).cross(mesh.nodes[v[2]] - mesh.nodes[v[0]]).norm();
+    const double a = polygon_area(mesh, v);
     shear += a * stress.shear[t].norm();
     axial += a * stress.shear[t][2];
     shear_area += a;

@@ -1,0 +1,15 @@
+#pragma once
+// Integrals of nodal fields over a boundary patch, face by face (each face's vector area times
+// the mean of its corner values): the flux through inlets and outlets, mean pressures.
+#include <vector>
+
+#include "hybrid_mesh.h"
+
+namespace naris::ns {
+
+// ∫ u·n dA over the faces of `patch` (n outward).
+double patch_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u, int patch);
+// Area-weighted mean of a nodal scalar over the faces of `patch`.
+double patch_mean(const HybridMesh& mesh, const std::vector<double>& values, int patch);
+
+}  // namespace naris::ns
