@@ -40,19 +40,30 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("--max-steps", job.max_steps, "continuation steps at most")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--picard-max", job.picard.max_iterations, "Picard iterations per step at most")
+  cmd->add_option("--max-iterations", job.picard.max_iterations,
+                  "nonlinear (Picard or Newton) iterations per continuation step at most")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--picard-steps", job.picard.picard_steps,
+                  "Picard steps before Newton's method takes over")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("!--no-newton", job.picard.newton,
+                "Picard iteration only (linear convergence; stalls at high Re)");
+  cmd->add_option("--linear-tolerance", job.picard.linear_tolerance,
+                  "each linear solve's residual reduction")
+      ->check(CLI::Range(1e-14, 0.5))
       ->capture_default_str();
   cmd->add_option("--tolerance", job.picard.tolerance,
                   "nonlinear residual relative to the load, per step")
       ->capture_default_str();
-  cmd->add_option("--relaxation", job.picard.relaxation, "Picard under-relaxation (0, 1]")
+  cmd->add_option("--relaxation", job.picard.relaxation, "largest step fraction (0, 1]; the step is cut back while the residual grows")
       ->check(CLI::Range(0.01, 1.0))
       ->capture_default_str();
   cmd->add_option("--restart", o->restart,
                   "resume the continuation from a checkpoint (the -o folder's checkpoint.h5 is "
                   "rewritten after every converged step)");
-  cmd->add_flag("--verbose", o->verbose, "a line per Picard step");
+  cmd->add_flag("--verbose", o->verbose, "a line per nonlinear (Picard or Newton) step");
   cmd->add_option("--petsc", o->petsc_options,
                   "PETSc options for the linear solves (prefix ns_), e.g. \"-ns_ksp_monitor\"");
   cmd->add_option("-o,--output", job.output, "output folder")->capture_default_str();

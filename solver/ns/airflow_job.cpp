@@ -136,7 +136,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     cs.residual = report.residuals.empty() ? NAN : report.residuals.back();
     cs.seconds = clock.seconds();
     r.steps.push_back(cs);
-    log_line(fmt::format("  Re {:8.1f}: {} after {} Picard steps, residual {:.2e}, {:.1f} s", re,
+    log_line(fmt::format("  Re {:8.1f}: {} after {} nonlinear steps, residual {:.2e}, {:.1f} s", re,
                          cs.converged ? "converged" : "FAILED", cs.iterations, cs.residual,
                          cs.seconds));
     if (cs.converged) {
@@ -146,10 +146,10 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       if (cs.iterations < job.picard.max_iterations / 3) step *= 1.5;
       re = std::min(r.reynolds, re + step);
     } else {
-      if (reached == 0.0)
+      if (reached == 0.0) {
         step = re *= 0.5;  // the very first step: start lower
-      else {
-        step *= 0.5;
+      } else {
+        step = 0.5 * (re - reached);  // half the increment that failed
         re = reached + step;
       }
       if (step < 1e-3 * r.reynolds)
@@ -299,7 +299,7 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
       "  pressure  drop inlet→outlet {:.3f} Pa; resistance {:.4f} Pa·s/mL\n"
       "  speed     max {:.3f} m/s\n"
       "  wall      shear stress mean {:.4f} Pa, max {:.4f} Pa; force {:.3e} N\n"
-      "  solve     {} continuation steps, {} Picard steps, {:.1f} s, peak {:.0f} MB\n"
+      "  solve     {} continuation steps, {} nonlinear steps, {:.1f} s, peak {:.0f} MB\n"
       "  wrote     {}",
       job.mesh.filename().string(), r.cells, r.nodes, r.inlet_area_mm2, r.inlet_perimeter_mm,
       r.d_in_mm, job.profile == InletProfile::uniform ? "uniform" : "developed", r.reynolds, r.u_in,

@@ -1,8 +1,9 @@
 #pragma once
-// Steady incompressible Navier–Stokes on a hybrid mesh by Picard iteration on the stabilized
-// Oseen problem (oseen_element.h), assembled into one PETSc matrix with 4×4 blocks per node
-// pair (preallocated from the node graph) and solved with a PETSc KSP (options prefix "ns_";
-// by default a direct LU through MUMPS). Convergence is judged on the full nonlinear residual.
+// Steady incompressible Navier–Stokes on a hybrid mesh: Picard steps on the stabilized Oseen
+// problem, then Newton's method (oseen_element.h), each a damped step with backtracking,
+// assembled into one PETSc matrix with 4×4 blocks per node pair (preallocated from the node
+// graph) and solved inexactly with a PETSc KSP (options prefix "ns_"; GMRES on ILU(1) by
+// default). Convergence is judged on the full nonlinear residual.
 #include <Eigen/Dense>
 #include <functional>
 #include <optional>
@@ -29,15 +30,22 @@ struct DirichletConditions {
 };
 
 struct PicardOptions {
-  int max_iterations = 100;
+  int max_iterations = 50;
   double tolerance = 1e-8;  // on the residual 2-norm relative to that of the load (F with data)
   double absolute_tolerance = 1e-13;
   double relaxation = 1.0;  // U ← U + ω (U* − U)
+  // Newton's method (oseen_element.h: only the reconstructed viscous term stays lagged) after
+  // this many Picard steps.
+  bool newton = true;
+  int picard_steps = 2;
+  // Each linear solve (for the correction, from a zero guess) stops when its residual has
+  // fallen by this factor: the nonlinear residual times this is what the step leaves unsolved.
+  double linear_tolerance = 1e-3;
   std::string options_prefix = "ns_";
-  bool log_iterations = false;
+  bool log_iterations = false;  // a line per step (residual, relaxation, linear iterations)
   // Outflow stabilization on this patch (the outlet; −1: none) with coefficient β ∈ [0, 1].
   int backflow_patch = -1;
-  double backflow_beta = 1.0;  // a line per Picard step (residual, relaxation, linear iterations)
+  double backflow_beta = 1.0;
 };
 
 struct PicardReport {

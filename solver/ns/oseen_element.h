@@ -19,6 +19,17 @@
 // ("do-nothing", traction-free for fully developed outflow). With a = u the element residual
 // K(u)u − F(u) is the discrete Navier–Stokes residual.
 //
+// Newton's method needs the derivative of that residual: K(u) plus, for a step δu,
+//
+//   ((δu·∇)u, w) + Σ_K τ_M ((δu·∇)w, r) + Σ_K τ_M ((u·∇)w + ∇q, (δu·∇)u)
+//   + Σ_K δτ_M ((u·∇)w + ∇q, r) + Σ_K δτ_C (∇·u, ∇·w)
+//
+// with r = (u·∇)u + ∇p − f the strong momentum residual and δτ the change of the τ's with u
+// (in the advective regime of the nasal airway they matter as much as the rest). Only the
+// reconstructed viscous term stays lagged (it carries a factor ν). Picard keeps only K(u):
+// linear convergence that stalls as Re grows; the derivative converges quadratically near
+// the solution.
+//
 // Degrees of freedom are interleaved per node: (u, v, w, p) of node 0, then node 1, …
 #include <Eigen/Dense>
 #include <algorithm>
@@ -33,6 +44,15 @@ template <int Nodes>
 struct ElementSystem {
   Eigen::Matrix<double, 4 * Nodes, 4 * Nodes> K;
   Eigen::Matrix<double, 4 * Nodes, 1> F;
+  Eigen::Matrix<double, 4 * Nodes, 1> R;  // K(a)·(a, p) − F: the residual at the iterate
+  Eigen::Matrix<double, 4 * Nodes, 4 * Nodes> newton;  // the derivative terms Picard leaves out
+};
+
+// What oseen_element computes besides K and F.
+enum class Linearization {
+  picard,          // K(a), F
+  picard_residual, // and R at (a, p)
+  newton,          // and R, and K + the Newton terms
 };
 
 // The metric of the reference cell: identity for the pyramid and the hexahedron (side 2); for
@@ -74,19 +94,24 @@ struct ShapeTable {
 
 // X: node coordinates, a: advection velocity at the nodes (both one row per node); grad: the
 // recovered nodal gradient of a, row j = G_j row-major (∂a_c/∂x_d at 3c + d), or null;
-// force(x) → f (Eigen::Vector3d) at a physical point.
+// force(x) → f (Eigen::Vector3d) at a physical point; p: the pressure at the nodes (read for
+// the residual and the Newton terms only).
 template <class E, class Force>
 void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
                    const Eigen::Matrix<double, E::nodes, 3>& a,
                    const Eigen::Matrix<double, E::nodes, 9>* grad, double nu, const Force& force,
-                   ElementSystem<E::nodes>& out) {
+                   ElementSystem<E::nodes>& out,
+                   const Eigen::Matrix<double, E::nodes, 1>& p = {},
+                   Linearization linearization = Linearization::picard) {
   constexpr int N = E::nodes;
   const ShapeTable<E>& table = ShapeTable<E>::get();
   const std::size_t nq = table.points.size();
   std::array<fem::MappedValues<N>, 27> mapped;
   for (std::size_t q = 0; q < nq; ++q) mapped[q] = fem::map_to_cell<E>(X, table.shapes[q]);
+  const bool newton = linearization == Linearization::newton;
   out.K.setZero();
   out.F.setZero();
+  if (newton) out.newton.setZero();
   for (std::size_t q = 0; q < nq; ++q) {
     const auto& m = mapped[q];
     const double w = table.points[q].weight * m.det_jacobian;
@@ -122,7 +147,38 @@ void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
       for (int c = 0; c < 3; ++c) out.F[4 * i + c] += w * (Nv[i] * f[c] + supg_i * f_stab[c]);
       out.F[4 * i + 3] += w * tau_m * G.row(i).dot(f_stab);
     }
+    if (!newton) continue;
+    const Eigen::Matrix3d grad_u = a.transpose() * G;  // (c, d) = ∂u_c/∂x_d
+    const Eigen::Vector3d r = grad_u * aq + G.transpose() * p - f_stab;
+    const double divergence = grad_u.trace();
+    // ∂τ_M/∂a = −τ_M³/3 · G a, and τ_C ∝ 1/τ_M.
+    const Eigen::Vector3d dtau = -tau_m * tau_m * tau_m / 3.0 * (metric * aq);
+    for (int i = 0; i < N; ++i) {
+      const double test = Nv[i] + tau_m * adv[i];
+      const Eigen::Vector3d pspg = tau_m * (G.row(i) * grad_u).transpose();
+      // What multiplies τ_M in row (i, c) and row (i, p), for the derivative of τ.
+      Eigen::Vector4d by_tau;
+      for (int c = 0; c < 3; ++c) by_tau[c] = adv[i] * r[c] - tau_c / tau_m * divergence * G(i, c);
+      by_tau[3] = G.row(i).dot(r);
+      for (int j = 0; j < N; ++j) {
+        const double wj = w * Nv[j];
+        for (int c = 0; c < 3; ++c)
+          for (int d = 0; d < 3; ++d)
+            out.newton(4 * i + c, 4 * j + d) +=
+                wj * (test * grad_u(c, d) + tau_m * G(i, d) * r[c] + dtau[d] * by_tau[c]);
+        for (int d = 0; d < 3; ++d)
+          out.newton(4 * i + 3, 4 * j + d) += wj * (pspg[d] + dtau[d] * by_tau[3]);
+      }
+    }
   }
+  if (linearization == Linearization::picard) return;
+  Eigen::Matrix<double, 4 * N, 1> state;
+  for (int i = 0; i < N; ++i) {
+    state.template segment<3>(4 * i) = a.row(i).transpose();
+    state[4 * i + 3] = p[i];
+  }
+  out.R.noalias() = out.K * state - out.F;
+  if (newton) out.K += out.newton;
 }
 
 }  // namespace naris::ns
