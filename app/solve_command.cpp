@@ -57,7 +57,13 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("--tolerance", job.picard.tolerance,
                   "nonlinear residual relative to the load, per step")
       ->capture_default_str();
-  cmd->add_option("--relaxation", job.picard.relaxation, "largest step fraction (0, 1]; the step is cut back while the residual grows")
+  cmd->add_option("--pseudo-cfl", job.picard.pseudo_cfl,
+                  "pseudo-transient continuation: first Courant number, grown as the residual "
+                  "falls (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--relaxation", job.picard.relaxation,
+                  "largest step fraction (0, 1]; the step is cut back while the residual grows")
       ->check(CLI::Range(0.01, 1.0))
       ->capture_default_str();
   cmd->add_option("--restart", o->restart,

@@ -116,6 +116,20 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     s.mesh_fingerprint = fingerprint;
     return s;
   };
+  // The residual history of every step, converged or not: on failure it is the evidence.
+  const fs::path csv = job.output / "residuals.csv";
+  auto write_residual_history = [&] {
+    AtomicOutput out(csv);
+    std::ofstream f(out.temp_path());
+    f << "step,reynolds,converged,iteration,residual\n";
+    for (std::size_t s = 0; s < r.steps.size(); ++s)
+      for (std::size_t i = 0; i < r.steps[s].residuals.size(); ++i)
+        f << s << ',' << r.steps[s].reynolds << ',' << r.steps[s].converged << ',' << i << ','
+          << fmt::format("{:.6e}", r.steps[s].residuals[i]) << '\n';
+    if (!f) fail("{}: write failed", csv.string());
+    f.close();
+    out.commit();
+  };
   PicardOptions picard = job.picard;
   picard.backflow_patch = outlet;
   for (int s = 0; s < job.max_steps && reached < r.reynolds; ++s) {
@@ -152,17 +166,21 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
         step = 0.5 * (re - reached);  // half the increment that failed
         re = reached + step;
       }
-      if (step < 1e-3 * r.reynolds)
+      if (step < 1e-3 * r.reynolds) {
+        write_residual_history();
         fail("the continuation stalled at Re {:.1f} (target {:.1f}): the step fell below {:.2f}{}",
              reached, r.reynolds, 1e-3 * r.reynolds,
              reached > 0.0 ? "; " + checkpoint.string() + " holds the last converged step" : "");
+      }
     }
   }
-  if (reached < r.reynolds)
+  if (reached < r.reynolds) {
+    write_residual_history();
     fail(
         "the continuation reached Re {:.1f} of {:.1f} in {} steps; {} holds that step (resume "
         "with --restart)",
         reached, r.reynolds, job.max_steps, checkpoint.string());
+  }
 
   // SI results.
   const double u = r.u_in, pscale = job.density * u * u;
@@ -221,19 +239,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   write_vtu(mesh, vtu, {}, fields);
   r.written.push_back(vtu.string());
 
-  const fs::path csv = job.output / "residuals.csv";
-  {
-    AtomicOutput out(csv);
-    std::ofstream f(out.temp_path());
-    f << "step,reynolds,converged,picard_iteration,residual\n";
-    for (std::size_t s = 0; s < r.steps.size(); ++s)
-      for (std::size_t i = 0; i < r.steps[s].residuals.size(); ++i)
-        f << s << ',' << r.steps[s].reynolds << ',' << r.steps[s].converged << ',' << i << ','
-          << fmt::format("{:.6e}", r.steps[s].residuals[i]) << '\n';
-    if (!f) fail("{}: write failed", csv.string());
-    f.close();
-    out.commit();
-  }
+  write_residual_history();
   r.written.push_back(csv.string());
   r.seconds = total.seconds();
   r.peak_memory = peak_memory_bytes();
@@ -243,7 +249,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     std::string steps;
     for (const auto& s : r.steps)
       steps += fmt::format(
-          "{}{{\"reynolds\": {:.6g}, \"converged\": {}, \"picard_iterations\": {}, \"residual\": "
+          "{}{{\"reynolds\": {:.6g}, \"converged\": {}, \"nonlinear_iterations\": {}, "
+          "\"residual\": "
           "{:.6e}, \"seconds\": {:.3f}}}",
           steps.empty() ? "" : ", ", s.reynolds, s.converged ? "true" : "false", s.iterations,
           s.residual, s.seconds);

@@ -60,6 +60,7 @@ class OseenSystem {
     check(VecSetBlockSize(rhs_, 4), "VecSetBlockSize");
     check(VecDuplicate(rhs_, solution_.out()), "VecDuplicate");
     check(VecDuplicate(rhs_, residual_.out()), "VecDuplicate");
+    check(VecDuplicate(rhs_, scratch_.out()), "VecDuplicate");
   }
 
   Mat matrix() const { return matrix_; }
@@ -99,6 +100,27 @@ class OseenSystem {
     run(mesh_.hexes, fem::Hex8{});
     for (std::size_t n = 0; n < mass.size(); ++n)
       if (mass[n] > 0.0) gradient_[n] /= mass[n];
+    lumped_mass_ = std::move(mass);
+  }
+
+  // Pseudo-transient continuation (Kelley & Keyes 1998): adds M/Δτ to the velocity rows of the
+  // matrix — not to the residual, so the converged answer is the steady one. Δτ is local,
+  // CFL · h / (|a| + ν/h) with h = (∫N_i)^⅓, so every node advances at the same Courant number.
+  // A finite CFL keeps the step a damped, time-like one where Newton's full step would
+  // overshoot, and makes the matrix more diagonally dominant for ILU.
+  void add_pseudo_time(const std::vector<Eigen::Vector3d>& advection, double nu, double cfl) {
+    PetscScalar* d = nullptr;
+    check(VecSet(scratch_, 0.0), "VecSet");
+    check(VecGetArray(scratch_, &d), "VecGetArray");
+    for (std::size_t n = 0; n < lumped_mass_.size(); ++n) {
+      const double m = lumped_mass_[n];
+      if (!(m > 0.0)) continue;
+      const double h = std::cbrt(m);
+      const double rate = (advection[n].norm() + nu / h) / (cfl * h);
+      for (int c = 0; c < 3; ++c) d[4 * n + static_cast<std::size_t>(c)] = m * rate;
+    }
+    check(VecRestoreArray(scratch_, &d), "VecRestoreArray");
+    check(MatDiagonalSet(matrix_, scratch_, ADD_VALUES), "MatDiagonalSet");
   }
 
   // K(a) and F(a) for advection a (per node), ν and f; with a residual-computing linearization
@@ -134,7 +156,9 @@ class OseenSystem {
     const bool newton = linearization == Linearization::newton;
     auto face = [&](std::span<const NodeId> v) {
       const int m = static_cast<int>(v.size());
-      const auto node = [&](int i) { return static_cast<std::size_t>(v[static_cast<std::size_t>(i)]); };
+      const auto node = [&](int i) {
+        return static_cast<std::size_t>(v[static_cast<std::size_t>(i)]);
+      };
       Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
       // Newton's share, d/du of the term with a = u: −β ∫ H(−u·n) (δu·n) (u·w); rows and
       // columns (4i + c) like PETSc's block.
@@ -160,7 +184,8 @@ class OseenSystem {
             for (int j = 0; j < 3; ++j) {
               M(tri[i], tri[j]) += weight * inflow * phi[i] * phi[j];
               if (newton)
-                D.block<3, 3>(4 * tri[i], 4 * tri[j]) += weight * phi[i] * phi[j] * a * normal.transpose();
+                D.block<3, 3>(4 * tri[i], 4 * tri[j]) +=
+                    weight * phi[i] * phi[j] * a * normal.transpose();
             }
         }
       }
@@ -229,8 +254,9 @@ class OseenSystem {
   int backflow_patch_ = -1;
   double backflow_beta_ = 0.0;
   petsc::Matrix matrix_;
-  petsc::Vector rhs_, solution_, residual_;
+  petsc::Vector rhs_, solution_, residual_, scratch_;
   std::vector<Eigen::Matrix<double, 1, 9>> gradient_;  // recovered ∇a per node
+  std::vector<double> lumped_mass_;                    // ∫ N_i per node
 };
 
 void to_field(Vec v, FlowField& field) {
@@ -288,6 +314,11 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
   // `-ns_ksp_type preonly -ns_pc_type lu` gives a direct solve.
   check(KSPSetType(ksp, KSPGMRES), "KSPSetType");
   check(KSPGMRESSetRestart(ksp, 200), "KSPGMRESSetRestart");
+  // Right preconditioning: GMRES then minimizes the true residual, which is what the tolerance
+  // is meant for. With ILU on the neonatal airway's saddle-point matrix the left-preconditioned
+  // norm fell 1e-3 while the true one did not, and the "correction" raised the nonlinear
+  // residual even at 1/64 of a step.
+  check(KSPSetPCSide(ksp, PC_RIGHT), "KSPSetPCSide");
   check(KSPSetTolerances(ksp, options.linear_tolerance, 1e-30, PETSC_DEFAULT, 5000),
         "KSPSetTolerances");
   PC pc = nullptr;
@@ -321,6 +352,8 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
           previous.pressure[k] + omega * (target.pressure[k] - previous.pressure[k]);
     }
   };
+  const std::vector<double> zeros(rows.size(), 0.0);
+  double first_norm = INFINITY, cfl = INFINITY;
   int solves = 0, decreasing = 0, picard_run = 0;
   bool newton_step = false;  // the kind of the last solve
   for (int it = 0; solves <= options.max_iterations + 1 && it < 4 * options.max_iterations + 8;
@@ -333,19 +366,28 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
     system.assemble(
         stokes ? std::vector<Eigen::Vector3d>(n, Eigen::Vector3d::Zero()) : field.velocity,
         field.pressure, nu, force, linearization);
-    check(MatZeroRows(system.matrix(), static_cast<PetscInt>(rows.size()), rows.data(), 1.0,
-                      current, system.rhs()),
-          "MatZeroRows");
+    double norm = 0.0;
     if (!stokes) {
       // The nonlinear residual K(u)u − F(u) at the current iterate; fixed rows hold exactly.
-      const std::vector<double> zeros(rows.size(), 0.0);
       check(VecSetValues(system.residual(), static_cast<PetscInt>(rows.size()), rows.data(),
                          zeros.data(), INSERT_VALUES),
             "VecSetValues");
       check(VecAssemblyBegin(system.residual()), "VecAssemblyBegin");
       check(VecAssemblyEnd(system.residual()), "VecAssemblyEnd");
-      double norm = 0.0, load = 0.0;
       check(VecNorm(system.residual(), NORM_2, &norm), "VecNorm");
+      if (!std::isfinite(first_norm)) first_norm = norm;
+      // Switched evolution relaxation: the Courant number grows as the residual falls, so
+      // the steps turn into Newton's (or Picard's) as the iteration converges.
+      if (options.pseudo_cfl > 0.0 && norm > 0.0) {
+        cfl = options.pseudo_cfl * std::max(0.1, first_norm / norm);
+        if (cfl < 1e8) system.add_pseudo_time(field.velocity, nu, cfl);
+      }
+    }
+    check(MatZeroRows(system.matrix(), static_cast<PetscInt>(rows.size()), rows.data(), 1.0,
+                      current, system.rhs()),
+          "MatZeroRows");
+    if (!stokes) {
+      double load = 0.0;
       check(VecNorm(system.rhs(), NORM_2, &load), "VecNorm");
       // Relative to the load (forces and boundary data): an iterate that starts close, as a
       // warm start does, must not be held to a fraction of its own small first residual.
@@ -354,7 +396,10 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
         r.converged = true;
         break;
       }
-      if (!(norm < previous_norm) && !previous.pressure.empty() && omega > 1.0 / 64) {
+      // Under pseudo-time every step is taken: a transient may have to raise the residual on
+      // its way (a jet switching walls), and the falling CFL is the damping.
+      if (!(norm < previous_norm) && !previous.pressure.empty() && omega > 1.0 / 64 &&
+          !(options.pseudo_cfl > 0.0)) {
         omega *= 0.5;
         if (newton_step && omega < 0.125) picard_run = 0;
         relax();
@@ -373,10 +418,11 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
       if (solves > options.max_iterations) break;
     }
     // Solve for the correction δ = U* − U from a zero guess, so that the linear tolerance is
-    // relative to the current nonlinear residual (an inexact Newton/Picard step): Newton's
-    // J δ = −R, Picard's K(a) δ = F − K(a) U. The fixed rows, zeroed with a unit diagonal and
-    // their right-hand side set to U, give δ = 0 there.
-    if (newton) {
+    // relative to the current nonlinear residual (an inexact Newton/Picard step): J δ = −R
+    // with Newton's J or Picard's K(a) (R = K(u)U − F(u) for both). The pseudo-time term
+    // changes the matrix only. The first Stokes solve corrects the boundary data: K δ = F − K U.
+    // Fixed rows have a zero residual, so δ = 0 there.
+    if (!stokes) {
       check(VecAXPBY(system.rhs(), -1.0, 0.0, system.residual()), "VecAXPBY");
     } else {
       check(MatMult(system.matrix(), current, product), "MatMult");
@@ -391,9 +437,10 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
     if (options.log_iterations) {
       PetscInt linear = 0;
       check(KSPGetIterationNumber(ksp, &linear), "KSPGetIterationNumber");
-      log_line(fmt::format("    {} {:3d}: residual {:.3e}, relaxation {:.3f}, {} linear iterations",
-                           newton ? "Newton" : "Picard", solves, stokes ? NAN : previous_norm,
-                           stokes ? 1.0 : omega, static_cast<int>(linear)));
+      log_line(fmt::format(
+          "    {} {:3d}: residual {:.3e}, relaxation {:.3f}, CFL {:.3g}, {} linear iterations",
+          newton ? "Newton" : "Picard", solves, stokes ? NAN : previous_norm, stokes ? 1.0 : omega,
+          stokes ? INFINITY : cfl, static_cast<int>(linear)));
     }
     if (reason < 0) fail("the linear solver failed ({})", KSPConvergedReasons[reason]);
     if (stokes) {

@@ -41,6 +41,9 @@ struct PicardOptions {
   // Each linear solve (for the correction, from a zero guess) stops when its residual has
   // fallen by this factor: the nonlinear residual times this is what the step leaves unsolved.
   double linear_tolerance = 1e-3;
+  // Pseudo-transient continuation: the first step's Courant number (0: off), raised as the
+  // residual falls (CFL · R₀/R).
+  double pseudo_cfl = 0.0;
   std::string options_prefix = "ns_";
   bool log_iterations = false;  // a line per step (residual, relaxation, linear iterations)
   // Outflow stabilization on this patch (the outlet; −1: none) with coefficient β ∈ [0, 1].

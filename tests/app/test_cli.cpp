@@ -507,6 +507,32 @@ TEST_F(Cli, SolveBadInput) {
   expect_clean_failure(
       naris("solve " + cut.string() + " --restart " + (other / "checkpoint.h5").string() + o),
       "another mesh");
+  // A step that cannot converge (one nonlinear iteration allowed): the increment is halved
+  // until it falls below 1e-3 of the target, then one error line naming the checkpoint, which
+  // still holds the last converged Re; the residual history of the failed steps is written.
+  const fs::path good = dir_ / "in" / "good";
+  ASSERT_EQ(naris("solve " + cut.string() + " --re 8 -o " + good.string()).status, 0);
+  auto bytes = [](const fs::path& f) {
+    std::ifstream file(f, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(file)), {});
+  };
+  const std::string checkpoint = bytes(good / "checkpoint.h5");
+  const CliRun r = naris("solve " + cut.string() + " --re 2000 --max-iterations 1 --restart " +
+                         (good / "checkpoint.h5").string() + " -o " + good.string());
+  EXPECT_NE(r.status, 0);
+  const auto last = r.err.rfind("naris: error: ");
+  ASSERT_NE(last, std::string::npos) << r.err;
+  const std::string error = r.err.substr(last);
+  EXPECT_EQ(std::count(error.begin(), error.end(), '\n'), 1) << error;
+  EXPECT_NE(error.find("stalled at Re 8.0"), std::string::npos) << error;
+  EXPECT_NE(error.find("holds the last converged step"), std::string::npos) << error;
+  // Re 16 fails, then the halved increments: 12, 10; the next increment, 1, is below 2.
+  std::size_t failures = 0;
+  for (auto at = r.err.find("FAILED"); at != std::string::npos; at = r.err.find("FAILED", at + 1))
+    ++failures;
+  EXPECT_EQ(failures, 3u) << r.err;
+  EXPECT_EQ(bytes(good / "checkpoint.h5"), checkpoint);
+  EXPECT_NE(bytes(good / "residuals.csv").find("\n0,16,0,0,"), std::string::npos);
 }
 
 }  // namespace
