@@ -22,7 +22,8 @@ void add_solve_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "solve",
       "Solve the steady incompressible airflow in a mesh made by naris mesh (patches inlet, "
-      "outlet, wall): uniform or developed inlet velocity, traction-free outlet, no-slip walls, "
+      "outlet, wall): uniform, developed or expression inlet velocity, traction-free outlet, "
+      "no-slip walls, "
       "Reynolds-number continuation to the target; writes solution.h5 (+ .xdmf), solution.vtu, "
       "summary.json, residuals.csv and checkpoint.h5 into -o");
   cmd->add_option("mesh", job.mesh, "mesh.h5 written by naris mesh")->required();
@@ -30,9 +31,15 @@ void add_solve_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--inlet-speed", o->inlet_speed,
                   "mean inlet speed (m/s) instead of --re; Re then follows from it");
-  cmd->add_option("--inlet-profile", o->profile, "uniform or developed (laminar, any shape)")
-      ->check(CLI::IsMember({"uniform", "developed"}))
-      ->capture_default_str();
+  auto* profile =
+      cmd->add_option("--inlet-profile", o->profile, "uniform or developed (laminar, any shape)")
+          ->check(CLI::IsMember({"uniform", "developed"}))
+          ->capture_default_str();
+  auto* expression =
+      cmd->add_option("--inlet-expression", job.inlet_expression,
+                      "inlet profile as an expression of x, y, z and r (mm; r from the inlet's "
+                      "centroid), e.g. \"1-(r/1.5)^2\"; scaled to the mean inlet speed")
+          ->excludes(profile);
   cmd->add_option("--nu", job.viscosity, "kinematic viscosity (m²/s)")->capture_default_str();
   cmd->add_option("--rho", job.density, "density (kg/m³)")->capture_default_str();
   cmd->add_option("--re-start", job.start_reynolds, "first Reynolds number of the continuation")
@@ -73,7 +80,7 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("--petsc", o->petsc_options,
                   "PETSc options for the linear solves (prefix ns_), e.g. \"-ns_ksp_monitor\"");
   cmd->add_option("-o,--output", job.output, "output folder")->capture_default_str();
-  cmd->callback([o] {
+  cmd->callback([o, expression] {
     petsc::Session session;
     if (session.size() > 1)
       fail("naris solve runs on one MPI rank in this version; run it without mpirun");
@@ -83,8 +90,9 @@ void add_solve_command(CLI::App& app) {
     if (o->inlet_speed != 0.0) o->job.inlet_speed = o->inlet_speed;
     if (!o->restart.empty()) o->job.restart = o->restart;
     o->job.picard.log_iterations = o->verbose;
-    o->job.profile =
-        o->profile == "developed" ? ns::InletProfile::developed : ns::InletProfile::uniform;
+    o->job.profile = expression->count() > 0     ? ns::InletProfile::expression
+                     : o->profile == "developed" ? ns::InletProfile::developed
+                                                 : ns::InletProfile::uniform;
     const ns::AirflowResult r = ns::run_airflow_job(o->job);
     log_line(ns::format_airflow_summary(o->job, r));
   });

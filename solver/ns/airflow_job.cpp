@@ -11,6 +11,7 @@
 #include "io/atomic_file.h"
 #include "io/mesh_h5.h"
 #include "io/write_vtk.h"
+#include "ns/inlet_expression.h"
 #include "ns/patch_integrals.h"
 #include "ns/solution_file.h"
 #include "ns/wall_stress.h"
@@ -32,6 +33,36 @@ void check_job(const AirflowJob& job) {
   if (!(job.density > 0.0) || !std::isfinite(job.density))
     fail("the density must be positive and finite (got {} kg/m³)", job.density);
   if (!(job.start_reynolds > 0.0)) fail("the starting Reynolds number must be positive");
+  // A typo in the expression is an input error: caught here, before any output.
+  if (job.profile == InletProfile::expression) (void)InletExpression(job.inlet_expression);
+}
+
+std::string profile_name(const AirflowJob& job) {
+  switch (job.profile) {
+    case InletProfile::uniform:
+      return "uniform";
+    case InletProfile::developed:
+      return "developed";
+    case InletProfile::expression:
+      return "expression " + job.inlet_expression;
+  }
+  return {};
+}
+
+// A JSON string literal: quotes, backslashes and control characters escaped.
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(c));
+    } else {
+      out += c;
+    }
+  }
+  return out + '"';
 }
 
 }  // namespace
@@ -66,6 +97,16 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   r.u_in = job.inlet_speed ? *job.inlet_speed : job.reynolds * job.viscosity / d_in;
   r.reynolds = r.u_in * d_in / job.viscosity;
 
+  // The inlet velocity (mean 1 in units of U_in) from the geometry in mm, where a user's
+  // expression is written.
+  ProfileShape shape;
+  std::optional<InletExpression> expression;
+  if (job.profile == InletProfile::expression) {
+    expression.emplace(job.inlet_expression);
+    shape = [&](const Eigen::Vector3d& x, double distance) { return (*expression)(x, distance); };
+  }
+  const DirichletConditions bc = airflow_conditions(mesh, job.profile, 1.0, nullptr, shape);
+
   std::optional<SolutionState> resume;
   if (job.restart) {
     resume = read_solution_h5(*job.restart);
@@ -87,8 +128,6 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
 
   // Nondimensional geometry: lengths in units of d_in.
   for (auto& x : mesh.nodes) x /= r.d_in_mm;
-  InletSummary inlet_summary;
-  const DirichletConditions bc = airflow_conditions(mesh, job.profile, 1.0, &inlet_summary);
 
   // Reynolds-number continuation: each step warm-started from the last converged one; the
   // step grows after an easy step and is halved after a failed one.
@@ -267,22 +306,21 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     AtomicOutput out(json);
     std::ofstream f(out.temp_path());
     f << fmt::format(
-        "{{\n  \"mesh\": \"{}\",\n  \"cells\": {},\n  \"nodes\": {},\n  \"reynolds\": {:.6g},\n"
+        "{{\n  \"mesh\": {},\n  \"cells\": {},\n  \"nodes\": {},\n  \"reynolds\": {:.6g},\n"
         "  \"inlet_speed_m_s\": {:.6g},\n  \"inlet_hydraulic_diameter_mm\": {:.6g},\n"
         "  \"inlet_area_mm2\": {:.6g},\n  \"inlet_perimeter_mm\": {:.6g},\n"
         "  \"viscosity_m2_s\": {:.6g},\n  \"density_kg_m3\": {:.6g},\n  \"inlet_profile\": "
-        "\"{}\",\n"
+        "{},\n"
         "  \"flow_ml_s\": {:.6g},\n  \"outlet_flow_ml_s\": {:.6g},\n  \"pressure_drop_pa\": "
         "{:.6g},\n"
         "  \"resistance_pa_s_ml\": {:.6g},\n  \"max_speed_m_s\": {:.6g},\n  \"patches\": [{}\n  "
         "],\n"
         "  \"continuation\": [{}],\n"
         "  \"seconds\": {:.3f},\n  \"peak_memory_mb\": {:.1f}\n}}\n",
-        job.mesh.string(), r.cells, r.nodes, r.reynolds, r.u_in, r.d_in_mm, r.inlet_area_mm2,
-        r.inlet_perimeter_mm, job.viscosity, job.density,
-        job.profile == InletProfile::uniform ? "uniform" : "developed", r.flow_ml_s,
-        r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance, r.max_speed, patches, steps,
-        r.seconds, r.peak_memory / 1048576.0);
+        json_string(job.mesh.string()), r.cells, r.nodes, r.reynolds, r.u_in, r.d_in_mm,
+        r.inlet_area_mm2, r.inlet_perimeter_mm, job.viscosity, job.density,
+        json_string(profile_name(job)), r.flow_ml_s, r.outlet_flow_ml_s, r.pressure_drop_pa,
+        r.resistance, r.max_speed, patches, steps, r.seconds, r.peak_memory / 1048576.0);
     if (!f) fail("{}: write failed", json.string());
     f.close();
     out.commit();
@@ -309,11 +347,10 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
       "  solve     {} continuation steps, {} nonlinear steps, {:.1f} s, peak {:.0f} MB\n"
       "  wrote     {}",
       job.mesh.filename().string(), r.cells, r.nodes, r.inlet_area_mm2, r.inlet_perimeter_mm,
-      r.d_in_mm, job.profile == InletProfile::uniform ? "uniform" : "developed", r.reynolds, r.u_in,
-      job.viscosity, job.density, r.flow_ml_s, r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance,
-      r.max_speed, wall.mean_shear, wall.max_shear,
-      (wall.pressure_force + wall.viscous_force).norm(), r.steps.size(), picard, r.seconds,
-      r.peak_memory / 1048576.0, fmt::join(r.written, "\n            "));
+      r.d_in_mm, profile_name(job), r.reynolds, r.u_in, job.viscosity, job.density, r.flow_ml_s,
+      r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance, r.max_speed, wall.mean_shear,
+      wall.max_shear, (wall.pressure_force + wall.viscous_force).norm(), r.steps.size(), picard,
+      r.seconds, r.peak_memory / 1048576.0, fmt::join(r.written, "\n            "));
 }
 
 }  // namespace naris::ns

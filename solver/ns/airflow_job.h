@@ -21,6 +21,7 @@ struct AirflowJob {
   double viscosity = 1.5e-5;                  // kinematic, m²/s (air)
   double density = 1.2;                       // kg/m³ (air)
   InletProfile profile = InletProfile::uniform;
+  std::string inlet_expression;  // with InletProfile::expression (inlet_expression.h)
   double start_reynolds = 50.0;  // the first continuation step
   int max_steps = 40;            // continuation steps, failed ones included
   PicardOptions picard;          // per step

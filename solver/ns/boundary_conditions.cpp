@@ -141,7 +141,8 @@ DirichletConditions assemble(const InletGeometry& g, const Eigen::VectorXd& spee
 }  // namespace
 
 DirichletConditions airflow_conditions(const HybridMesh& mesh, InletProfile profile,
-                                       double mean_speed, InletSummary* summary) {
+                                       double mean_speed, InletSummary* summary,
+                                       const ProfileShape& shape) {
   if (!std::isfinite(mean_speed)) fail("the inlet speed is not finite");
   InletGeometry g = inlet_geometry(mesh);
   const FaceSystem s = face_system(mesh, g);
@@ -150,6 +151,20 @@ DirichletConditions airflow_conditions(const HybridMesh& mesh, InletProfile prof
     const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(s.stiffness);
     if (solver.info() != Eigen::Success) fail("the inlet profile's Poisson problem is singular");
     speed = solver.solve(s.load);
+  } else if (profile == InletProfile::expression) {
+    if (!shape) fail("an expression inlet profile needs its expression");
+    for (std::size_t k = 0; k < g.nodes.size(); ++k) {
+      const Eigen::Vector3d& x = mesh.nodes[g.nodes[k]];
+      const double v = shape(x, (x - g.summary.centroid).norm());
+      if (!std::isfinite(v) || v < 0.0)
+        fail(
+            "the inlet profile is {} at ({:.4g}, {:.4g}, {:.4g}): it must be finite and not "
+            "negative (air enters through the inlet)",
+            v, x[0], x[1], x[2]);
+      speed[static_cast<Eigen::Index>(k)] = v;
+    }
+    if (!(s.load.dot(speed) > 0.0))
+      fail("the inlet profile is zero on the whole inlet (off its rim): no air enters");
   }
   // Scale so that the flux is mean_speed × area: the rim is held at zero, so an unscaled
   // "uniform" profile would carry less than its nominal flow.

@@ -12,7 +12,11 @@
 
 namespace naris::ns {
 
-enum class InletProfile { uniform, developed };
+enum class InletProfile { uniform, developed, expression };
+
+// A profile shape: the value at position x and distance r from the inlet's centroid (both in
+// the mesh's length unit).
+using ProfileShape = std::function<double(const Eigen::Vector3d& x, double r)>;
 
 struct InletSummary {
   double area = 0.0;                                 // of the inlet patch
@@ -21,11 +25,13 @@ struct InletSummary {
   double flux = 0.0;  // ∫ u·n_in dA of the imposed velocity
 };
 
-// Dirichlet data for mean inlet speed `mean_speed`. Throws naris::Error when the mesh has no
-// `inlet` or no `outlet` patch, or the inlet is not a planar face. Nodes on the rim of the
-// inlet belong to the wall (no slip wins).
+// Dirichlet data for mean inlet speed `mean_speed`; `shape` (for InletProfile::expression) is
+// scaled to that mean. Throws naris::Error when the mesh has no `inlet` or no `outlet` patch,
+// the inlet is not a planar face, or the shape is not finite, negative somewhere or zero
+// everywhere. Nodes on the rim of the inlet belong to the wall (no slip wins).
 DirichletConditions airflow_conditions(const HybridMesh& mesh, InletProfile profile,
-                                       double mean_speed, InletSummary* summary = nullptr);
+                                       double mean_speed, InletSummary* summary = nullptr,
+                                       const ProfileShape& shape = {});
 
 // The same with a profile given as a function of the position (speed along the inward normal).
 DirichletConditions airflow_conditions(const HybridMesh& mesh,

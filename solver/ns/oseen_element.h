@@ -50,9 +50,9 @@ struct ElementSystem {
 
 // What oseen_element computes besides K and F.
 enum class Linearization {
-  picard,          // K(a), F
-  picard_residual, // and R at (a, p)
-  newton,          // and R, and K + the Newton terms
+  picard,           // K(a), F
+  picard_residual,  // and R at (a, p)
+  newton,           // and R, and K + the Newton terms
 };
 
 // The metric of the reference cell: identity for the pyramid and the hexahedron (side 2); for
@@ -100,8 +100,7 @@ template <class E, class Force>
 void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
                    const Eigen::Matrix<double, E::nodes, 3>& a,
                    const Eigen::Matrix<double, E::nodes, 9>* grad, double nu, const Force& force,
-                   ElementSystem<E::nodes>& out,
-                   const Eigen::Matrix<double, E::nodes, 1>& p = {},
+                   ElementSystem<E::nodes>& out, const Eigen::Matrix<double, E::nodes, 1>& p = {},
                    Linearization linearization = Linearization::picard) {
   constexpr int N = E::nodes;
   const ShapeTable<E>& table = ShapeTable<E>::get();

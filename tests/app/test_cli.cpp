@@ -476,6 +476,15 @@ TEST_F(Cli, SolvesTheFlowThroughACutBall) {
   EXPECT_NEAR(summary(resumed, "pressure_drop_pa"), direct, 1e-5 * direct);
   EXPECT_NEAR(summary(resumed, "max_speed_m_s"), summary(solution, "max_speed_m_s"),
               1e-5 * summary(solution, "max_speed_m_s"));
+  // A constant expression is the uniform profile: the same answer, and the summary says which.
+  const fs::path typed = dir_ / "out" / "typed";
+  r = naris("solve " + mesh.string() + " --re 20 --inlet-expression \"3 + 0*x*r\" -o " +
+            typed.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NEAR(summary(typed, "pressure_drop_pa"), direct, 1e-5 * direct);
+  std::ifstream file(typed / "summary.json");
+  const std::string text((std::istreambuf_iterator<char>(file)), {});
+  EXPECT_NE(text.find("\"inlet_profile\": \"expression 3 + 0*x*r\""), std::string::npos) << text;
 }
 
 TEST_F(Cli, SolveBadInput) {
@@ -490,6 +499,13 @@ TEST_F(Cli, SolveBadInput) {
   expect_clean_failure(naris("solve " + cut.string() + " --re 0" + o), "must be positive");
   expect_clean_failure(naris("solve " + cut.string() + " --re -5" + o), "must be positive");
   expect_clean_failure(naris("solve " + cut.string() + " --re nan" + o), "positive and finite");
+  expect_clean_failure(naris("solve " + cut.string() + " --inlet-expression \"1-(r\"" + o),
+                       "inlet expression '1-(r'");
+  expect_clean_failure(naris("solve " + cut.string() + " --inlet-expression \"r-1\"" + o),
+                       "not negative");
+  expect_clean_failure(
+      naris("solve " + cut.string() + " --inlet-expression 1 --inlet-profile developed" + o),
+      "excludes");
   expect_clean_failure(naris("solve " + (dir_ / "in" / "absent.h5").string() + o), "absent.h5");
   const fs::path junk = dir_ / "in" / "junk.h5";
   std::ofstream(junk) << "not hdf5";
