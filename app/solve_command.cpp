@@ -1,4 +1,6 @@
 // `naris solve`: the steady airflow in a mesh at a target Reynolds number (dissertation 4.2.4).
+#include <fmt/format.h>
+
 #include <memory>
 
 #include "commands.h"
@@ -82,8 +84,8 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("-o,--output", job.output, "output folder")->capture_default_str();
   cmd->callback([o, expression] {
     petsc::Session session;
-    if (session.size() > 1)
-      fail("naris solve runs on one MPI rank in this version; run it without mpirun");
+    // Under mpirun every rank runs the job and shares the solves; the first one speaks.
+    if (session.rank() > 0) set_verbosity(Verbosity::quiet);
     if (!o->petsc_options.empty())
       petsc::check(PetscOptionsInsertString(nullptr, o->petsc_options.c_str()),
                    "PetscOptionsInsertString");
@@ -93,6 +95,7 @@ void add_solve_command(CLI::App& app) {
     o->job.profile = expression->count() > 0     ? ns::InletProfile::expression
                      : o->profile == "developed" ? ns::InletProfile::developed
                                                  : ns::InletProfile::uniform;
+    if (session.size() > 1) log_line(fmt::format("naris solve: {} MPI ranks", session.size()));
     const ns::AirflowResult r = ns::run_airflow_job(o->job);
     log_line(ns::format_airflow_summary(o->job, r));
   });

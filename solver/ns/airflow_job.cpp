@@ -123,6 +123,11 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   }
   // Every input is checked: only now does the job touch the output folder.
   ensure_writable_folder(job.output);
+  // Under MPI every rank runs the job on the whole mesh and shares the solves; the first
+  // writes the files.
+  int rank = 0;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  const bool writer = rank == 0;
   log_line(fmt::format("naris solve: {} ({} cells), Re {:.1f} on d_in {:.3f} mm, U_in {:.4f} m/s",
                        job.mesh.string(), r.cells, r.reynolds, r.d_in_mm, r.u_in));
 
@@ -195,7 +200,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     if (cs.converged) {
       last_good = field;
       reached = re;
-      write_solution_h5(state_at(re), checkpoint);  // the last good step, always on disk
+      if (writer) write_solution_h5(state_at(re), checkpoint);  // the last good step, on disk
       if (cs.iterations < job.picard.max_iterations / 3) step *= 1.5;
       re = std::min(r.reynolds, re + step);
     } else {
@@ -206,7 +211,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
         re = reached + step;
       }
       if (step < 1e-3 * r.reynolds) {
-        write_residual_history();
+        if (writer) write_residual_history();
         fail("the continuation stalled at Re {:.1f} (target {:.1f}): the step fell below {:.2f}{}",
              reached, r.reynolds, 1e-3 * r.reynolds,
              reached > 0.0 ? "; " + checkpoint.string() + " holds the last converged step" : "");
@@ -214,7 +219,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     }
   }
   if (reached < r.reynolds) {
-    write_residual_history();
+    if (writer) write_residual_history();
     fail(
         "the continuation reached Re {:.1f} of {:.1f} in {} steps; {} holds that step (resume "
         "with --restart)",
@@ -238,6 +243,11 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     r.patches.push_back({p.name, p.area * r.d_in_mm * r.d_in_mm, p.pressure * force_scale,
                          p.viscous * force_scale, p.mean_shear * pscale, p.max_shear * pscale});
 
+  if (!writer) {
+    r.seconds = total.seconds();
+    r.peak_memory = peak_memory_bytes();
+    return r;
+  }
   // Files, in millimetres again.
   for (auto& x : mesh.nodes) x *= r.d_in_mm;
   {

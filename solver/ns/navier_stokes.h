@@ -4,6 +4,8 @@
 // assembled into one PETSc matrix with 4×4 blocks per node pair (preallocated from the node
 // graph) and solved inexactly with a PETSc KSP (options prefix "ns_"; GMRES on ILU(1) by
 // default). Convergence is judged on the full nonlinear residual.
+#include <petscsys.h>  // MPI_Comm, without the MPI C++ bindings
+
 #include <Eigen/Dense>
 #include <functional>
 #include <optional>
@@ -45,6 +47,9 @@ struct PicardOptions {
   // residual falls (CFL · R₀/R).
   double pseudo_cfl = 0.0;
   std::string options_prefix = "ns_";
+  // The ranks that share the system (MPI_COMM_NULL: PETSC_COMM_WORLD); each needs the whole
+  // mesh and returns the whole field.
+  MPI_Comm communicator = MPI_COMM_NULL;
   bool log_iterations = false;  // a line per step (residual, relaxation, linear iterations)
   // Outflow stabilization on this patch (the outlet; −1: none) with coefficient β ∈ [0, 1].
   int backflow_patch = -1;

@@ -60,5 +60,6 @@ class Handle {
 using Matrix = Handle<Mat, MatDestroy>;
 using Vector = Handle<Vec, VecDestroy>;
 using LinearSolver = Handle<KSP, KSPDestroy>;
+using Scatter = Handle<VecScatter, VecScatterDestroy>;
 
 }  // namespace naris::petsc

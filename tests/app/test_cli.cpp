@@ -33,10 +33,11 @@ class Cli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  CliRun naris(const std::string& args) {
+  // `launcher` runs the binary (mpiexec …) when given.
+  CliRun naris(const std::string& args, const std::string& launcher = "") {
     const fs::path err = dir_ / "stderr.txt";
     const std::string cmd =
-        std::string(NARIS_BINARY) + " " + args + " 2> " + err.string() + " > /dev/null";
+        launcher + std::string(NARIS_BINARY) + " " + args + " 2> " + err.string() + " > /dev/null";
     CliRun r;
     const int raw = std::system(cmd.c_str());
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -84,6 +85,16 @@ class Cli : public ::testing::Test {
   }
 
   std::string out() const { return "-o " + (dir_ / "out" / "mesh.h5").string(); }
+
+  // A number from the summary.json in `folder` (six significant digits).
+  static double summary(const fs::path& folder, const std::string& key) {
+    std::ifstream file(folder / "summary.json");
+    const std::string text((std::istreambuf_iterator<char>(file)), {});
+    std::smatch m;
+    const std::regex number("\"" + key + "\": ([-0-9.e+]+)");
+    if (!std::regex_search(text, m, number)) ADD_FAILURE() << key << " missing in " << folder;
+    return m.empty() ? NAN : std::stod(m[1]);
+  }
 
   fs::path dir_;
 };
@@ -452,14 +463,6 @@ TEST_F(Cli, SolvesTheFlowThroughACutBall) {
                         "residuals.csv", "checkpoint.h5"})
     EXPECT_TRUE(fs::exists(solution / f)) << f;
   // Mass balance and the restart, from summary.json (six significant digits).
-  auto summary = [](const fs::path& folder, const std::string& key) {
-    std::ifstream file(folder / "summary.json");
-    const std::string text((std::istreambuf_iterator<char>(file)), {});
-    std::smatch m;
-    const std::regex number("\"" + key + "\": ([-0-9.e+]+)");
-    if (!std::regex_search(text, m, number)) ADD_FAILURE() << key << " missing in " << folder;
-    return m.empty() ? NAN : std::stod(m[1]);
-  };
   const double inflow = summary(solution, "flow_ml_s");
   EXPECT_GT(inflow, 0.0);
   EXPECT_NEAR(summary(solution, "outlet_flow_ml_s"), inflow, 1e-5 * inflow);
@@ -485,6 +488,26 @@ TEST_F(Cli, SolvesTheFlowThroughACutBall) {
   std::ifstream file(typed / "summary.json");
   const std::string text((std::istreambuf_iterator<char>(file)), {});
   EXPECT_NE(text.find("\"inlet_profile\": \"expression 3 + 0*x*r\""), std::string::npos) << text;
+}
+
+// The same binary under mpiexec: two ranks share the solves, one writes; the answer is the
+// serial one to the six digits of summary.json.
+TEST_F(Cli, SolveOnTwoRanksMatchesOneRank) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const fs::path mesh = dir_ / "in" / "mesh.h5";
+  ASSERT_EQ(naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string()).status,
+            0);
+  const fs::path one = dir_ / "one", two = dir_ / "two";
+  ASSERT_EQ(naris("solve " + mesh.string() + " --re 40 -o " + one.string()).status, 0);
+  const CliRun r = naris("solve " + mesh.string() + " --re 40 -o " + two.string(),
+                         // Open MPI refuses root (CI runs as root) unless told.
+                         "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 " +
+                             std::string(NARIS_MPIEXEC) + " -n 2 --oversubscribe ");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("2 MPI ranks"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("naris solve: mesh.h5"), r.err.rfind("naris solve: mesh.h5")) << r.err;
+  for (const char* key : {"pressure_drop_pa", "max_speed_m_s", "outlet_flow_ml_s"})
+    EXPECT_NEAR(summary(two, key), summary(one, key), 2e-6 * std::abs(summary(one, key))) << key;
 }
 
 TEST_F(Cli, SolveBadInput) {
