@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "core/error.h"
 #include "core/log.h"
 #include "ns/oseen_element.h"
+#include "ns/segregated_step.h"
 #include "parallel/petsc.h"
 
 namespace naris::ns {
@@ -42,7 +44,7 @@ std::vector<std::vector<NodeId>> node_graph(const HybridMesh& mesh, NodeId lo, N
 class OseenSystem {
  public:
   OseenSystem(const HybridMesh& mesh, MPI_Comm comm, const std::string& prefix, int backflow_patch,
-              double backflow_beta)
+              double backflow_beta, MatType type)
       : mesh_(mesh), backflow_patch_(backflow_patch), backflow_beta_(backflow_beta) {
     int rank = 0, size = 1;
     MPI_Comm_rank(comm, &rank);
@@ -93,7 +95,7 @@ class OseenSystem {
     check(MatSetSizes(matrix_, 4 * local, 4 * local, 4 * n, 4 * n), "MatSetSizes");
     // 4×4 blocks by default (a third less memory and faster ILU); `-ns_mat_type aij` for
     // preconditioners that split the fields inside a block (fieldsplit).
-    check(MatSetType(matrix_, MATBAIJ), "MatSetType");
+    check(MatSetType(matrix_, type), "MatSetType");
     check(MatSetBlockSize(matrix_, 4), "MatSetBlockSize");
     check(MatSetOptionsPrefix(matrix_, prefix.c_str()), "MatSetOptionsPrefix");
     check(MatSetFromOptions(matrix_), "MatSetFromOptions");
@@ -376,8 +378,17 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
       options.communicator == MPI_COMM_NULL ? PETSC_COMM_WORLD : options.communicator;
   int ranks = 1;
   MPI_Comm_size(comm, &ranks);
+  using Scheme = PicardOptions::Scheme;
+  const bool segregated = options.scheme == Scheme::segregated;
+  // The segregated sweep takes the velocity and pressure blocks out: scalar (AIJ) storage.
   OseenSystem system(mesh, comm, options.options_prefix, options.backflow_patch,
-                     options.backflow_beta);
+                     options.backflow_beta, options.scheme == Scheme::coupled ? MATBAIJ : MATAIJ);
+  std::optional<SegregatedStep> sweep;
+  if (segregated)
+    sweep.emplace(system.matrix(), options.options_prefix, options.velocity_relaxation,
+                  options.pressure_relaxation);
+  if (options.scheme == Scheme::segregated_krylov)
+    sweep.emplace(system.matrix(), options.options_prefix, 1.0, 1.0, true);
   // Fixed rows, those of this rank: three per velocity node, one for the pinned pressure.
   std::vector<PetscInt> rows;
   for (std::size_t k = 0; k < bc.nodes.size(); ++k) {
@@ -410,7 +421,9 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
         "KSPSetTolerances");
   PC pc = nullptr;
   check(KSPGetPC(ksp, &pc), "KSPGetPC");
-  if (ranks == 1) {
+  if (options.scheme == Scheme::segregated_krylov) {
+    sweep->use_as_preconditioner(pc);
+  } else if (ranks == 1) {
     check(PCSetType(pc, PCILU), "PCSetType");
     check(PCFactorSetLevels(pc, 1), "PCFactorSetLevels");
     check(PCFactorSetMatOrderingType(pc, MATORDERINGRCM), "PCFactorSetMatOrderingType");
@@ -460,7 +473,8 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
   for (int it = 0; solves <= options.max_iterations + 1 && it < 4 * options.max_iterations + 8;
        ++it) {
     system.distribute(field, current);
-    const bool newton = !stokes && options.newton && picard_run >= options.picard_steps;
+    const bool newton =
+        !stokes && options.newton && !segregated && picard_run >= options.picard_steps;
     const auto linearization =
         stokes ? Linearization::picard
                : (newton ? Linearization::newton : Linearization::picard_residual);
@@ -534,20 +548,26 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
       check(MatMult(system.matrix(), current, product), "MatMult");
       check(VecAXPY(system.rhs(), -1.0, product), "VecAXPY");
     }
-    check(KSPSetOperators(ksp, system.matrix(), system.matrix()), "KSPSetOperators");
-    check(KSPSolve(ksp, system.rhs(), system.solution()), "KSPSolve");
+    KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+    std::string linear;
+    if (segregated) {
+      sweep->apply(system.matrix(), system.rhs(), system.solution());
+      linear = fmt::format("{} momentum and {} pressure iterations", sweep->momentum_iterations(),
+                           sweep->pressure_iterations());
+    } else {
+      check(KSPSetOperators(ksp, system.matrix(), system.matrix()), "KSPSetOperators");
+      check(KSPSolve(ksp, system.rhs(), system.solution()), "KSPSolve");
+      check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
+      PetscInt its = 0;
+      check(KSPGetIterationNumber(ksp, &its), "KSPGetIterationNumber");
+      linear = fmt::format("{} linear iterations", its);
+    }
     check(VecAYPX(system.solution(), 1.0, current), "VecAYPX");
     ++solves;
-    KSPConvergedReason reason;
-    check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
-    if (options.log_iterations && system.rank() == 0) {
-      PetscInt linear = 0;
-      check(KSPGetIterationNumber(ksp, &linear), "KSPGetIterationNumber");
-      log_line(fmt::format(
-          "    {} {:3d}: residual {:.3e}, relaxation {:.3f}, CFL {:.3g}, {} linear iterations",
-          newton ? "Newton" : "Picard", solves, stokes ? NAN : previous_norm, stokes ? 1.0 : omega,
-          stokes ? INFINITY : cfl, static_cast<int>(linear)));
-    }
+    if (options.log_iterations && system.rank() == 0)
+      log_line(fmt::format("    {} {:3d}: residual {:.3e}, relaxation {:.3f}, CFL {:.3g}, {}",
+                           newton ? "Newton" : "Picard", solves, stokes ? NAN : previous_norm,
+                           stokes ? 1.0 : omega, stokes ? INFINITY : cfl, linear));
     if (reason < 0) fail("the linear solver failed ({})", KSPConvergedReasons[reason]);
     if (stokes) {
       system.gather(system.solution(), field);

@@ -46,6 +46,13 @@ struct PicardOptions {
   // Pseudo-transient continuation: the first step's Courant number (0: off), raised as the
   // residual falls (CFL · R₀/R).
   double pseudo_cfl = 0.0;
+  // coupled: each step solves the whole linearized system (GMRES on ILU); segregated: one
+  // sweep of FiDAP's segregated scheme (segregated_step.h) per Picard step, relaxed by
+  // α_u and α_p — Picard only; segregated_krylov: GMRES on the whole system preconditioned by
+  // that sweep (one AMG V-cycle per field, no relaxation).
+  enum class Scheme { coupled, segregated, segregated_krylov };
+  Scheme scheme = Scheme::coupled;
+  double velocity_relaxation = 0.7, pressure_relaxation = 0.3;
   std::string options_prefix = "ns_";
   // The ranks that share the system (MPI_COMM_NULL: PETSC_COMM_WORLD); each needs the whole
   // mesh and returns the whole field.

@@ -61,5 +61,6 @@ using Matrix = Handle<Mat, MatDestroy>;
 using Vector = Handle<Vec, VecDestroy>;
 using LinearSolver = Handle<KSP, KSPDestroy>;
 using Scatter = Handle<VecScatter, VecScatterDestroy>;
+using IndexSet = Handle<IS, ISDestroy>;
 
 }  // namespace naris::petsc
