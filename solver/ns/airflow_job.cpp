@@ -178,13 +178,25 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   };
   PicardOptions picard = job.picard;
   picard.backflow_patch = outlet;
+  // With pseudo-time available, each Re is tried first without it, on a short budget: Newton
+  // from the last solution follows the steady branch even where that branch is unstable, which
+  // time-like steps cannot (on the neonatal airway near Re 600 they wander at residuals of
+  // 1e-1 to 1e-2). Where Newton fails — near Re 190 there, where the branch ends — the same Re
+  // is retried with pseudo-time before the increment is halved.
+  const bool pseudo_available = job.picard.pseudo_cfl > 0.0;
+  bool pseudo_retry = false;
   for (int s = 0; s < job.max_steps && reached < r.reynolds; ++s) {
     ContinuationStep cs;
     cs.reynolds = re;
     Stopwatch clock;
     PicardReport report;
+    PicardOptions attempt = picard;
+    if (pseudo_available && !pseudo_retry) {
+      attempt.pseudo_cfl = 0.0;
+      attempt.max_iterations = std::min(picard.max_iterations, 25);
+    }
     try {
-      field = solve_navier_stokes(mesh, 1.0 / re, {}, bc, picard, &report,
+      field = solve_navier_stokes(mesh, 1.0 / re, {}, bc, attempt, &report,
                                   reached > 0.0 ? &last_good : nullptr);
       cs.converged = report.converged;
     } catch (const Error& e) {
@@ -196,16 +208,21 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     cs.residual = report.residuals.empty() ? NAN : report.residuals.back();
     cs.seconds = clock.seconds();
     r.steps.push_back(cs);
-    log_line(fmt::format("  Re {:8.1f}: {} after {} nonlinear steps, residual {:.2e}, {:.1f} s", re,
-                         cs.converged ? "converged" : "FAILED", cs.iterations, cs.residual,
+    log_line(fmt::format("  Re {:8.1f}: {} after {} nonlinear steps{}, residual {:.2e}, {:.1f} s",
+                         re, cs.converged ? "converged" : "FAILED", cs.iterations,
+                         attempt.pseudo_cfl > 0.0 ? " with pseudo-time" : "", cs.residual,
                          cs.seconds));
     if (cs.converged) {
       last_good = field;
       reached = re;
       if (writer) write_solution_h5(state_at(re), checkpoint);  // the last good step, on disk
-      if (cs.iterations < job.picard.max_iterations / 3) step *= 1.5;
+      if (cs.iterations < attempt.max_iterations / 3) step *= 1.5;
       re = std::min(r.reynolds, re + step);
+      pseudo_retry = false;
+    } else if (pseudo_available && !pseudo_retry) {
+      pseudo_retry = true;  // the same Re again, with pseudo-time
     } else {
+      pseudo_retry = false;
       if (reached == 0.0) {
         step = re *= 0.5;  // the very first step: start lower
       } else {
