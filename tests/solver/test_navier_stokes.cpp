@@ -134,10 +134,10 @@ TEST(NavierStokes, EthierSteinmanConvergesAtSecondOrderInVelocity) {
                     std::string(kind) + " nu " + std::to_string(nu));
 }
 
-// Picard alone, Newton, Newton under pseudo-transient continuation and FiDAP's segregated
-// scheme take different paths to the same discrete solution: the pseudo-time term, the line
-// search and the segregated sweep change the matrix and the steps, never the residual being
-// driven to zero.
+// Picard alone, Newton, Newton under pseudo-transient continuation, FiDAP's segregated scheme
+// and GMRES preconditioned by its sweep take different paths to the same discrete solution:
+// the pseudo-time term, the line search and the segregated sweep change the matrix and the
+// steps, never the residual being driven to zero.
 TEST(NavierStokes, PicardNewtonPseudoTimeAndSegregatedReachTheSameSolution) {
   const double nu = 0.01;
   const BodyForce force = [nu](const Eigen::Vector3d& x) -> Eigen::Vector3d {
@@ -145,17 +145,18 @@ TEST(NavierStokes, PicardNewtonPseudoTimeAndSegregatedReachTheSameSolution) {
   };
   const HybridMesh mesh = testing::convergence_mesh("mve-ball", 8);
   const auto bc = exact_on_boundary(mesh, beltrami, beltrami_pressure);
-  PicardOptions picard, newton, pseudo, segregated;
-  for (PicardOptions* o : {&picard, &newton, &pseudo, &segregated}) {
+  PicardOptions picard, newton, pseudo, segregated, preconditioned;
+  for (PicardOptions* o : {&picard, &newton, &pseudo, &segregated, &preconditioned}) {
     o->tolerance = 1e-10;
     o->max_iterations = 400;
   }
   picard.newton = false;
   pseudo.pseudo_cfl = 1.0;
   segregated.scheme = PicardOptions::Scheme::segregated;
+  preconditioned.scheme = PicardOptions::Scheme::segregated_krylov;
   std::vector<FlowField> fields;
   std::vector<int> steps;
-  for (const PicardOptions* o : {&picard, &newton, &pseudo, &segregated}) {
+  for (const PicardOptions* o : {&picard, &newton, &pseudo, &segregated, &preconditioned}) {
     PicardReport report;
     fields.push_back(solve_navier_stokes(mesh, nu, force, bc, *o, &report));
     EXPECT_TRUE(report.converged);
@@ -163,11 +164,11 @@ TEST(NavierStokes, PicardNewtonPseudoTimeAndSegregatedReachTheSameSolution) {
   }
   std::printf(
       "[ info ] nonlinear steps: Picard %d, Newton %d, Newton with pseudo-time %d, segregated "
-      "%d\n",
-      steps[0], steps[1], steps[2], steps[3]);
+      "%d, segregated-preconditioned Newton %d\n",
+      steps[0], steps[1], steps[2], steps[3], steps[4]);
   double scale = 0.0;
   for (const auto& v : fields[1].velocity) scale = std::max(scale, v.norm());
-  for (const std::size_t k : {std::size_t{0}, std::size_t{2}, std::size_t{3}}) {
+  for (const std::size_t k : {std::size_t{0}, std::size_t{2}, std::size_t{3}, std::size_t{4}}) {
     double du = 0.0;
     for (std::size_t n = 0; n < mesh.nodes.size(); ++n)
       du = std::max(du, (fields[k].velocity[n] - fields[1].velocity[n]).norm());
