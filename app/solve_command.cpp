@@ -85,6 +85,11 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("--tolerance", job.picard.tolerance,
                   "nonlinear residual relative to the load, per step")
       ->capture_default_str();
+  cmd->add_option("--step-tolerance", job.step_tolerance,
+                  "nonlinear residual of the continuation steps before the target (the target's "
+                  "is --tolerance)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_option("--pseudo-cfl", job.picard.pseudo_cfl,
                   "pseudo-transient continuation: first Courant number, grown as the residual "
                   "falls (0: off)")

@@ -136,8 +136,10 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
 
   // Reynolds-number continuation: each step warm-started from the last converged one; the
   // step grows after an easy step and is halved after a failed one.
-  // `reached` is the last converged Re (0: none yet); `last_good` its field.
-  FlowField field, last_good;
+  // `reached` is the last converged Re (0: none yet); `last_good` its field; `earlier` the
+  // converged field before it, at Re `earlier_re` (0: none).
+  FlowField field, last_good, earlier, predicted;
+  double earlier_re = 0.0;
   double re = std::min(job.start_reynolds, r.reynolds), step = re;
   double reached = 0.0;
   if (resume) {
@@ -191,13 +193,29 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     Stopwatch clock;
     PicardReport report;
     PicardOptions attempt = picard;
+    if (re < r.reynolds) attempt.tolerance = std::max(picard.tolerance, job.step_tolerance);
     if (pseudo_available && !pseudo_retry) {
       attempt.pseudo_cfl = 0.0;
       attempt.max_iterations = std::min(picard.max_iterations, 25);
     }
+    // The first try at each Re starts from the secant predictor through the last two converged
+    // fields, u(Re) ≈ u₁ + (u₁ − u₀)(Re − Re₁)/(Re₁ − Re₀) (the boundary data are the same, so
+    // it keeps them): on the phantom it takes a Newton step or two off every continuation step.
+    // The retry with pseudo-time starts from the last converged field itself.
+    const bool predict = earlier_re > 0.0 && !pseudo_retry;
+    if (predict) {
+      const double t = (1.0 / re - 1.0 / reached) / (1.0 / reached - 1.0 / earlier_re);
+      predicted = last_good;
+      for (std::size_t k = 0; k < predicted.pressure.size(); ++k) {
+        predicted.velocity[k] += t * (last_good.velocity[k] - earlier.velocity[k]);
+        predicted.pressure[k] += t * (last_good.pressure[k] - earlier.pressure[k]);
+      }
+    }
     try {
       field = solve_navier_stokes(mesh, 1.0 / re, {}, bc, attempt, &report,
-                                  reached > 0.0 ? &last_good : nullptr);
+                                  predict         ? &predicted
+                                  : reached > 0.0 ? &last_good
+                                                  : nullptr);
       cs.converged = report.converged;
     } catch (const Error& e) {
       cs.converged = false;  // a diverged iteration: treated as a failed step
@@ -213,6 +231,10 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
                          attempt.pseudo_cfl > 0.0 ? " with pseudo-time" : "", cs.residual,
                          cs.seconds));
     if (cs.converged) {
+      if (reached > 0.0) {
+        earlier = std::move(last_good);
+        earlier_re = reached;
+      }
       last_good = field;
       reached = re;
       if (writer) write_solution_h5(state_at(re), checkpoint);  // the last good step, on disk

@@ -24,7 +24,10 @@ struct AirflowJob {
   std::string inlet_expression;  // with InletProfile::expression (inlet_expression.h)
   double start_reynolds = 50.0;  // the first continuation step
   int max_steps = 40;            // continuation steps, failed ones included
-  PicardOptions picard;          // per step
+  // The nonlinear tolerance of the steps before the target (relative to the load, like
+  // picard.tolerance, which holds at the target): they only start the next one.
+  double step_tolerance = 1e-5;
+  PicardOptions picard;  // per step
   // Resume from this checkpoint (a solution file of the same mesh) instead of starting low.
   std::optional<std::filesystem::path> restart;
 };
