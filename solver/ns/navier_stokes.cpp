@@ -536,6 +536,11 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
       }
       previous_norm = norm;
       if (solves > options.max_iterations) break;
+      const auto& history = r.residuals;
+      const auto window = static_cast<std::size_t>(options.stall_steps);
+      if (window > 0 && history.size() > window &&
+          history.back() > 0.5 * history[history.size() - 1 - window])
+        break;
     }
     // Solve for the correction δ = U* − U from a zero guess, so that the linear tolerance is
     // relative to the current nonlinear residual (an inexact Newton/Picard step): J δ = −R

@@ -46,6 +46,9 @@ struct PicardOptions {
   // Pseudo-transient continuation: the first step's Courant number (0: off), raised as the
   // residual falls (CFL · R₀/R).
   double pseudo_cfl = 0.0;
+  // Give up (not converged) when the residual has not halved over this many steps (0: never):
+  // a stalled attempt is better retried another way than run to max_iterations.
+  int stall_steps = 0;
   // coupled: each step solves the whole linearized system (GMRES on ILU); segregated: one
   // sweep of FiDAP's segregated scheme (segregated_step.h) per Picard step, relaxed by
   // α_u and α_p — Picard only; segregated_krylov: GMRES on the whole system preconditioned by

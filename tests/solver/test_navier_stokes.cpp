@@ -138,13 +138,20 @@ TEST(NavierStokes, EthierSteinmanConvergesAtSecondOrderInVelocity) {
 // and GMRES preconditioned by its sweep take different paths to the same discrete solution:
 // the pseudo-time term, the line search and the segregated sweep change the matrix and the
 // steps, never the residual being driven to zero.
-TEST(NavierStokes, PicardNewtonPseudoTimeAndSegregatedReachTheSameSolution) {
-  const double nu = 0.01;
-  const BodyForce force = [nu](const Eigen::Vector3d& x) -> Eigen::Vector3d {
+// The steady Ethier–Steinman flow at ν = 0.01 on the MVE ball at n = 8: mesh, force and the
+// exact velocity on the boundary.
+struct BeltramiBall {
+  double nu = 0.01;
+  BodyForce force = [nu = nu](const Eigen::Vector3d& x) -> Eigen::Vector3d {
     return nu * kD * kD * beltrami(x);
   };
-  const HybridMesh mesh = testing::convergence_mesh("mve-ball", 8);
-  const auto bc = exact_on_boundary(mesh, beltrami, beltrami_pressure);
+  HybridMesh mesh = testing::convergence_mesh("mve-ball", 8);
+  DirichletConditions bc = exact_on_boundary(mesh, beltrami, beltrami_pressure);
+};
+
+TEST(NavierStokes, PicardNewtonPseudoTimeAndSegregatedReachTheSameSolution) {
+  const BeltramiBall problem;
+  const auto& [nu, force, mesh, bc] = problem;
   PicardOptions picard, newton, pseudo, segregated, preconditioned;
   for (PicardOptions* o : {&picard, &newton, &pseudo, &segregated, &preconditioned}) {
     o->tolerance = 1e-10;
@@ -176,6 +183,26 @@ TEST(NavierStokes, PicardNewtonPseudoTimeAndSegregatedReachTheSameSolution) {
   }
   // Newton converges in fewer steps than Picard's linear rate allows.
   EXPECT_LT(steps[1], steps[0]);
+}
+
+// An iteration that crawls — here Picard held to 5 % steps, so the residual falls a few
+// percent a step — is given up once it has not halved over `stall_steps` steps, long before
+// max_iterations; left alone it would go on.
+TEST(NavierStokes, StalledIterationGivesUpEarly) {
+  const BeltramiBall problem;
+  PicardOptions crawl;
+  crawl.newton = false;
+  crawl.relaxation = 0.05;
+  crawl.max_iterations = 60;
+  crawl.stall_steps = 4;
+  PicardReport report;
+  solve_navier_stokes(problem.mesh, problem.nu, problem.force, problem.bc, crawl, &report);
+  EXPECT_FALSE(report.converged);
+  ASSERT_GE(report.residuals.size(), 5u);
+  EXPECT_LE(report.iterations, 8);
+  const auto& h = report.residuals;
+  EXPECT_GT(h.back(), 0.5 * h[h.size() - 5]);  // the reason it stopped
+  EXPECT_LT(h.back(), h.front());              // still falling: only slowly
 }
 
 // The Newton matrix is the derivative of the element residual: against central differences of
