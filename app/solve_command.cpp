@@ -29,8 +29,9 @@ void add_solve_command(CLI::App& app) {
       "Solve the steady incompressible airflow in a mesh made by naris mesh (patches inlet, "
       "outlet, wall): uniform, developed or expression inlet velocity, traction-free outlet, "
       "no-slip walls, "
-      "Reynolds-number continuation to the target; writes solution.h5 (+ .xdmf), solution.vtu, "
-      "summary.json, residuals.csv and checkpoint.h5 into -o");
+      "Reynolds-number continuation to the target; writes solution.h5 (+ .xdmf), solution.vtu "
+      "(under MPI solution.pvtu with a piece per rank), boundary.vtp, summary.json, residuals.csv "
+      "and checkpoint.h5 into -o");
   cmd->add_option("mesh", job.mesh, "mesh.h5 written by naris mesh")->required();
   cmd->add_option("--re", job.reynolds, "target Reynolds number on the inlet's d_in = 4A/P")
       ->capture_default_str();
@@ -110,9 +111,16 @@ void add_solve_command(CLI::App& app) {
     petsc::Session session;
     // Under mpirun every rank runs the job and shares the solves; the first one speaks.
     if (session.rank() > 0) set_verbosity(Verbosity::quiet);
-    if (!o->petsc_options.empty())
+    if (!o->petsc_options.empty()) {
       petsc::check(PetscOptionsInsertString(nullptr, o->petsc_options.c_str()),
                    "PetscOptionsInsertString");
+      // PETSc starts its event log at initialization only when -log_view is already set
+      // (PETSC_OPTIONS); given here, the log is begun now so PetscFinalize has one to print.
+      PetscBool log_view = PETSC_FALSE;
+      petsc::check(PetscOptionsHasName(nullptr, nullptr, "-log_view", &log_view),
+                   "PetscOptionsHasName");
+      if (log_view) petsc::check(PetscLogDefaultBegin(), "PetscLogDefaultBegin");
+    }
     if (o->inlet_speed != 0.0) o->job.inlet_speed = o->inlet_speed;
     if (!o->restart.empty()) o->job.restart = o->restart;
     o->job.picard.log_iterations = o->verbose;

@@ -191,6 +191,103 @@ void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
   out.commit();
 }
 
+std::filesystem::path pvtu_piece_path(const std::filesystem::path& path, int piece) {
+  return path.parent_path() / fmt::format("{}_{}.vtu", path.stem().string(), piece);
+}
+
+void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path, int piece,
+                      int pieces, const std::function<bool(std::size_t)>& owned,
+                      const CellFields& cell_fields, const PointFields& point_fields) {
+  // The piece as a mesh of its own (nodes renumbered in their global order) and, for every
+  // piece node and cell, where its values are in the whole mesh's fields.
+  HybridMesh part;
+  std::vector<NodeId> local(mesh.nodes.size(), -1);
+  std::vector<std::size_t> cells;
+  std::size_t c = 0;
+  auto take = [&](const auto& from, auto& to) {
+    for (const auto& cell : from) {
+      if (owned(c)) {
+        cells.push_back(c);
+        to.push_back(cell);
+        for (NodeId n : cell) local[static_cast<std::size_t>(n)] = 0;
+      }
+      ++c;
+    }
+  };
+  take(mesh.tets, part.tets);
+  take(mesh.pyramids, part.pyramids);
+  take(mesh.hexes, part.hexes);
+  std::vector<std::size_t> global;
+  for (std::size_t n = 0; n < local.size(); ++n)
+    if (local[n] == 0) {
+      local[n] = static_cast<NodeId>(global.size());
+      global.push_back(n);
+      part.nodes.push_back(mesh.nodes[n]);
+    }
+  auto renumber = [&](auto& cells_of_type) {
+    for (auto& cell : cells_of_type)
+      for (NodeId& n : cell) n = local[static_cast<std::size_t>(n)];
+  };
+  renumber(part.tets);
+  renumber(part.pyramids);
+  renumber(part.hexes);
+
+  CellFields part_cells;
+  for (const auto& [name, values] : cell_fields) {
+    if (values.size() != mesh.cell_count())
+      fail("internal: cell field '{}' has {} values for {} cells", name, values.size(),
+           mesh.cell_count());
+    auto& v = part_cells[name];
+    v.reserve(cells.size());
+    for (std::size_t k : cells) v.push_back(values[k]);
+  }
+  PointFields part_points;
+  for (const auto& [name, field] : point_fields) {
+    const auto m = static_cast<std::size_t>(field.components);
+    if (field.values.size() != m * mesh.nodes.size())
+      fail("internal: point field '{}' has {} values for {} nodes", name, field.values.size(),
+           mesh.nodes.size());
+    auto& f = part_points[name];
+    f.components = field.components;
+    f.values.reserve(m * global.size());
+    for (std::size_t n : global)
+      for (std::size_t k = 0; k < m; ++k) f.values.push_back(field.values[m * n + k]);
+  }
+  write_vtu(part, pvtu_piece_path(path, piece), part_cells, part_points);
+  if (piece != 0) return;
+
+  std::string xml =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" "
+      "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n <PUnstructuredGrid "
+      "GhostLevel=\"0\">\n  <PPoints>\n   <PDataArray type=\"Float64\" "
+      "NumberOfComponents=\"3\"/>\n  </PPoints>\n";
+  if (!cell_fields.empty()) {
+    xml += "  <PCellData>\n";
+    for (const auto& [name, values] : cell_fields)
+      xml += fmt::format("   <PDataArray type=\"Float32\" Name=\"{}\"/>\n", name);
+    xml += "  </PCellData>\n";
+  }
+  if (!point_fields.empty()) {
+    xml += "  <PPointData>\n";
+    for (const auto& [name, field] : point_fields)
+      xml +=
+          fmt::format("   <PDataArray type=\"Float32\" Name=\"{}\" NumberOfComponents=\"{}\"/>\n",
+                      name, field.components);
+    xml += "  </PPointData>\n";
+  }
+  for (int k = 0; k < pieces; ++k)
+    xml += fmt::format("  <Piece Source=\"{}\"/>\n", pvtu_piece_path(path, k).filename().string());
+  xml += " </PUnstructuredGrid>\n</VTKFile>\n";
+  AtomicOutput out(path);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(out.temp_path().c_str(), "wb"),
+                                                       &std::fclose);
+  if (!file || std::fwrite(xml.data(), 1, xml.size(), file.get()) != xml.size() ||
+      std::fflush(file.get()) != 0)
+    fail("{}: write failed", path.string());
+  file.reset();
+  out.commit();
+}
+
 namespace {
 vtkSmartPointer<vtkPolyData> boundary_polydata(const HybridMesh& mesh, bool triangulate) {
   std::vector<vtkIdType> offsets{0}, connectivity;

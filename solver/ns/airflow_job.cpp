@@ -15,6 +15,7 @@
 #include "ns/patch_integrals.h"
 #include "ns/solution_file.h"
 #include "ns/wall_stress.h"
+#include "parallel/partition.h"
 #include "patches/patches.h"
 #include "quality/check.h"
 
@@ -63,6 +64,18 @@ std::string json_string(const std::string& text) {
     }
   }
   return out + '"';
+}
+
+// Before a run writes its volume as `vtu` (ranks == 1) or as `pvtu` with `ranks` pieces: the
+// files of the other form, and pieces beyond the new count, from an earlier run.
+void remove_stale_volume_files(const fs::path& vtu, const fs::path& pvtu, int ranks) {
+  std::error_code ignored;  // absent is the usual case
+  if (ranks > 1)
+    fs::remove(vtu, ignored);
+  else
+    fs::remove(pvtu, ignored);
+  for (int k = ranks > 1 ? ranks : 0; fs::exists(pvtu_piece_path(pvtu, k)); ++k)
+    fs::remove(pvtu_piece_path(pvtu, k), ignored);
 }
 
 }  // namespace
@@ -290,26 +303,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     r.patches.push_back({p.name, p.area * r.d_in_mm * r.d_in_mm, p.pressure * force_scale,
                          p.viscous * force_scale, p.mean_shear * pscale, p.max_shear * pscale});
 
-  if (!writer) {
-    r.seconds = total.seconds();
-    r.peak_memory = peak_memory_bytes();
-    return r;
-  }
   // Files, in millimetres again.
   for (auto& x : mesh.nodes) x *= r.d_in_mm;
-  {
-    PointFields faces;
-    PointField vec{3, {}}, mag{1, {}};
-    for (const auto& s : stress.shear) {
-      for (int c = 0; c < 3; ++c) vec.values.push_back(s[c] * pscale);
-      mag.values.push_back(s.norm() * pscale);
-    }
-    faces["wall_shear_stress"] = std::move(vec);
-    faces["wall_shear_stress_magnitude"] = std::move(mag);
-    const fs::path vtp = job.output / "boundary.vtp";
-    write_boundary_vtp(mesh, vtp, faces);
-    r.written.push_back(vtp.string());
-  }
   PointFields fields;
   auto vector_field = [&](double scale) {
     PointField f{3, {}};
@@ -327,13 +322,52 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   fields["pressure"] = scalar_field(pscale);
   fields["velocity_nondimensional"] = vector_field(1.0);
   fields["pressure_nondimensional"] = scalar_field(1.0);
+  // The volume: one file from a serial run; under MPI a .pvtu whose pieces the ranks write at
+  // once, each its own cells. Files of the other form left by an earlier run are removed, so
+  // the folder never offers two different answers.
+  int ranks = 1;
+  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
+  const fs::path vtu = job.output / "solution.vtu", pvtu = job.output / "solution.pvtu";
+  if (writer) remove_stale_volume_files(vtu, pvtu, ranks);
+  if (ranks == 1) {
+    write_vtu(mesh, vtu, {}, fields);
+    r.written.push_back(vtu.string());
+  } else {
+    const parallel::NodeRange range = parallel::owned_nodes(mesh.nodes.size(), rank, ranks);
+    const std::size_t tets = mesh.tets.size(), pyramids = mesh.pyramids.size();
+    write_pvtu_piece(
+        mesh, pvtu, rank, ranks,
+        [&](std::size_t c) {
+          return c < tets ? parallel::owns_cell(range, mesh.tets[c])
+                 : c < tets + pyramids
+                     ? parallel::owns_cell(range, mesh.pyramids[c - tets])
+                     : parallel::owns_cell(range, mesh.hexes[c - tets - pyramids]);
+        },
+        {}, fields);
+    r.written.push_back(pvtu.string() + fmt::format(" (+ {} pieces)", ranks));
+  }
+  if (!writer) {
+    r.seconds = total.seconds();
+    r.peak_memory = peak_memory_bytes();
+    return r;
+  }
+  {
+    PointFields faces;
+    PointField vec{3, {}}, mag{1, {}};
+    for (const auto& s : stress.shear) {
+      for (int c = 0; c < 3; ++c) vec.values.push_back(s[c] * pscale);
+      mag.values.push_back(s.norm() * pscale);
+    }
+    faces["wall_shear_stress"] = std::move(vec);
+    faces["wall_shear_stress_magnitude"] = std::move(mag);
+    const fs::path vtp = job.output / "boundary.vtp";
+    write_boundary_vtp(mesh, vtp, faces);
+    r.written.push_back(vtp.string());
+  }
   const fs::path h5 = job.output / "solution.h5";
   write_solution_h5(state_at(reached), h5, &mesh, job.mesh);
   r.written.push_back(h5.string());
   r.written.push_back(fs::path(h5).replace_extension(".xdmf").string());
-  const fs::path vtu = job.output / "solution.vtu";
-  write_vtu(mesh, vtu, {}, fields);
-  r.written.push_back(vtu.string());
 
   write_residual_history();
   r.written.push_back(csv.string());

@@ -10,6 +10,7 @@
 #include "core/log.h"
 #include "ns/oseen_element.h"
 #include "ns/segregated_step.h"
+#include "parallel/partition.h"
 #include "parallel/petsc.h"
 
 namespace naris::ns {
@@ -37,9 +38,8 @@ std::vector<std::vector<NodeId>> node_graph(const HybridMesh& mesh, NodeId lo, N
   return g;
 }
 
-// The system over the ranks of `comm`: rank r owns the nodes [lo_r, hi_r), a contiguous range
-// (the mesher numbers nodes slab by slab, so a range is a slab of the geometry), their four
-// rows, and assembles the cells whose smallest node it owns. Every rank holds the mesh and the
+// The system over the ranks of `comm`: rank r owns the nodes [lo_r, hi_r) and their four rows,
+// and assembles the cells it owns (parallel/partition.h). Every rank holds the mesh and the
 // whole current iterate, which the solve gathers after each step.
 class OseenSystem {
  public:
@@ -51,8 +51,9 @@ class OseenSystem {
     MPI_Comm_size(comm, &size);
     rank_ = rank;
     const auto n = static_cast<std::int64_t>(mesh.nodes.size());
-    lo_ = static_cast<NodeId>(n * rank / size);
-    hi_ = static_cast<NodeId>(n * (rank + 1) / size);
+    const parallel::NodeRange range = parallel::owned_nodes(mesh.nodes.size(), rank, size);
+    lo_ = range.first;
+    hi_ = range.end;
     if (size > 1) {
       owned_cells(mesh.tets, owned_tets_);
       owned_cells(mesh.pyramids, owned_pyramids_);
@@ -308,7 +309,7 @@ class OseenSystem {
   template <class Cells>
   void owned_cells(const Cells& cells, std::vector<std::size_t>& owned) const {
     for (std::size_t c = 0; c < cells.size(); ++c)
-      if (owns(*std::min_element(cells[c].begin(), cells[c].end()))) owned.push_back(c);
+      if (parallel::owns_cell({lo_, hi_}, cells[c])) owned.push_back(c);
   }
 
   template <class E, class Cells, class Force>

@@ -490,8 +490,9 @@ TEST_F(Cli, SolvesTheFlowThroughACutBall) {
   EXPECT_NE(text.find("\"inlet_profile\": \"expression 3 + 0*x*r\""), std::string::npos) << text;
 }
 
-// The same binary under mpiexec: two ranks share the solves, one writes; the answer is the
-// serial one to the six digits of summary.json.
+// The same binary under mpiexec: two ranks share the solves, one writes all but the volume,
+// which each rank writes a piece of; the answer is the serial one to the six digits of
+// summary.json.
 TEST_F(Cli, SolveOnTwoRanksMatchesOneRank) {
   const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
   const fs::path mesh = dir_ / "in" / "mesh.h5";
@@ -508,6 +509,11 @@ TEST_F(Cli, SolveOnTwoRanksMatchesOneRank) {
   EXPECT_EQ(r.err.find("naris solve: mesh.h5"), r.err.rfind("naris solve: mesh.h5")) << r.err;
   for (const char* key : {"pressure_drop_pa", "max_speed_m_s", "outlet_flow_ml_s"})
     EXPECT_NEAR(summary(two, key), summary(one, key), 2e-6 * std::abs(summary(one, key))) << key;
+  // The volume as ParaView's parallel format, a piece per rank, instead of one file.
+  for (const char* f : {"solution.pvtu", "solution_0.vtu", "solution_1.vtu"})
+    EXPECT_TRUE(fs::exists(two / f)) << f;
+  EXPECT_FALSE(fs::exists(two / "solution.vtu"));
+  EXPECT_FALSE(fs::exists(one / "solution.pvtu"));
 }
 
 TEST_F(Cli, SolveBadInput) {

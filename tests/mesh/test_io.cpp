@@ -4,10 +4,12 @@
 #include <vtkCellData.h>
 #include <vtkCellType.h>
 #include <vtkDataArray.h>
+#include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkSTLReader.h>
 #include <vtkSmartPointer.h>
 #include <vtkUnstructuredGrid.h>
+#include <vtkXMLPUnstructuredGridReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
 #include <filesystem>
@@ -101,6 +103,63 @@ TEST(Vtk, VtuAndStlReadBack) {
   stl->Update();
   EXPECT_EQ(stl->GetOutput()->GetNumberOfCells(),
             static_cast<vtkIdType>(m.boundary_tris.size() + 2 * m.boundary_quads.size()));
+}
+
+// Three pieces, each the cells of one third of the nodes (by smallest node, as the MPI ranks
+// share them), read back through the .pvtu by VTK's parallel reader: every cell once, with its
+// cell value, and every point's field equal to the field of its coordinates.
+TEST(Vtk, PvtuPiecesCoverTheMeshOnce) {
+  const HybridMesh m = sample_mesh();
+  const fs::path dir = temp_dir() / "pvtu";
+  fs::create_directories(dir);
+  CellFields cells;
+  auto& index = cells["index"];
+  for (std::size_t c = 0; c < m.cell_count(); ++c) index.push_back(static_cast<double>(c));
+  PointFields points;
+  auto& coordinates = points["x"];
+  coordinates.components = 3;
+  for (const auto& x : m.nodes)
+    for (int k = 0; k < 3; ++k) coordinates.values.push_back(x[k]);
+  constexpr int kPieces = 3;
+  std::vector<NodeId> smallest;
+  auto add = [&](const auto& of_type) {
+    for (const auto& c : of_type) smallest.push_back(*std::min_element(c.begin(), c.end()));
+  };
+  add(m.tets);
+  add(m.pyramids);
+  add(m.hexes);
+  const auto n = static_cast<NodeId>(m.nodes.size());
+  for (int piece = 0; piece < kPieces; ++piece)
+    write_pvtu_piece(
+        m, dir / "flow.pvtu", piece, kPieces,
+        [&](std::size_t c) { return smallest[c] * kPieces / n == piece; }, cells, points);
+  for (int piece = 0; piece < kPieces; ++piece)
+    EXPECT_TRUE(fs::exists(dir / ("flow_" + std::to_string(piece) + ".vtu"))) << piece;
+
+  auto reader = vtkSmartPointer<vtkXMLPUnstructuredGridReader>::New();
+  reader->SetFileName((dir / "flow.pvtu").c_str());
+  reader->Update();
+  vtkUnstructuredGrid* grid = reader->GetOutput();
+  ASSERT_EQ(grid->GetNumberOfCells(), static_cast<vtkIdType>(m.cell_count()));
+  // Nodes on a piece boundary appear in each piece that uses them.
+  EXPECT_GT(grid->GetNumberOfPoints(), static_cast<vtkIdType>(m.nodes.size()));
+  vtkDataArray* read_index = grid->GetCellData()->GetArray("index");
+  ASSERT_NE(read_index, nullptr);
+  std::vector<int> seen(m.cell_count(), 0);
+  for (vtkIdType c = 0; c < grid->GetNumberOfCells(); ++c)
+    ++seen[static_cast<std::size_t>(read_index->GetTuple1(c))];
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(m.cell_count()));
+  vtkDataArray* read_x = grid->GetPointData()->GetArray("x");
+  ASSERT_NE(read_x, nullptr);
+  ASSERT_EQ(read_x->GetNumberOfComponents(), 3);
+  double worst = 0.0;
+  for (vtkIdType p = 0; p < grid->GetNumberOfPoints(); ++p) {
+    double x[3];
+    grid->GetPoint(p, x);
+    for (int k = 0; k < 3; ++k)
+      worst = std::max(worst, std::abs(read_x->GetComponent(p, k) - x[k]));
+  }
+  EXPECT_LT(worst, 1e-5);  // the fields are Float32
 }
 
 TEST(Gmsh, HasPhysicalGroupsAndEveryElement) {
