@@ -335,20 +335,41 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   } else {
     const parallel::NodeRange range = parallel::owned_nodes(mesh.nodes.size(), rank, ranks);
     const std::size_t tets = mesh.tets.size(), pyramids = mesh.pyramids.size();
-    write_pvtu_piece(
-        mesh, pvtu, rank, ranks,
-        [&](std::size_t c) {
-          return c < tets ? parallel::owns_cell(range, mesh.tets[c])
-                 : c < tets + pyramids
-                     ? parallel::owns_cell(range, mesh.pyramids[c - tets])
-                     : parallel::owns_cell(range, mesh.hexes[c - tets - pyramids]);
-        },
-        {}, fields);
+    // A rank that cannot write its piece (disk full) must not leave the others waiting in the
+    // reductions below: every rank learns that one failed.
+    std::string failure;
+    try {
+      write_pvtu_piece(
+          mesh, pvtu, rank, ranks,
+          [&](std::size_t c) {
+            return c < tets ? parallel::owns_cell(range, mesh.tets[c])
+                   : c < tets + pyramids
+                       ? parallel::owns_cell(range, mesh.pyramids[c - tets])
+                       : parallel::owns_cell(range, mesh.hexes[c - tets - pyramids]);
+          },
+          {}, fields);
+    } catch (const Error& e) {
+      failure = e.what();
+    }
+    int failed = failure.empty() ? 0 : 1, any_failed = 0;
+    MPI_Allreduce(&failed, &any_failed, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD);
+    if (failed) fail("{}", failure);
+    if (any_failed) fail("{}: another rank could not write its piece", pvtu.string());
     r.written.push_back(pvtu.string() + fmt::format(" (+ {} pieces)", ranks));
+  }
+  // Memory: the largest rank's peak is what each machine of a cluster must have, the sum what
+  // the run took in all.
+  {
+    const auto mine = static_cast<unsigned long long>(peak_memory_bytes());
+    unsigned long long largest = mine, sum = mine;
+    MPI_Allreduce(&mine, &largest, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, PETSC_COMM_WORLD);
+    MPI_Allreduce(&mine, &sum, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, PETSC_COMM_WORLD);
+    r.ranks = ranks;
+    r.peak_memory = largest;
+    r.total_peak_memory = sum;
   }
   if (!writer) {
     r.seconds = total.seconds();
-    r.peak_memory = peak_memory_bytes();
     return r;
   }
   {
@@ -372,7 +393,10 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   write_residual_history();
   r.written.push_back(csv.string());
   r.seconds = total.seconds();
-  r.peak_memory = peak_memory_bytes();
+  // The first rank also wrote the files: its own peak may have grown since.
+  const std::size_t own = peak_memory_bytes();
+  r.total_peak_memory += own - std::min(own, r.peak_memory);
+  r.peak_memory = std::max(r.peak_memory, own);
 
   const fs::path json = job.output / "summary.json";
   {
@@ -407,11 +431,13 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
         "  \"resistance_pa_s_ml\": {:.6g},\n  \"max_speed_m_s\": {:.6g},\n  \"patches\": [{}\n  "
         "],\n"
         "  \"continuation\": [{}],\n"
-        "  \"seconds\": {:.3f},\n  \"peak_memory_mb\": {:.1f}\n}}\n",
+        "  \"mpi_ranks\": {},\n  \"seconds\": {:.3f},\n  \"peak_memory_mb\": {:.1f},\n"
+        "  \"peak_memory_all_ranks_mb\": {:.1f}\n}}\n",
         json_string(job.mesh.string()), r.cells, r.nodes, r.reynolds, r.u_in, r.d_in_mm,
         r.inlet_area_mm2, r.inlet_perimeter_mm, job.viscosity, job.density,
         json_string(profile_name(job)), r.flow_ml_s, r.outlet_flow_ml_s, r.pressure_drop_pa,
-        r.resistance, r.max_speed, patches, steps, r.seconds, r.peak_memory / 1048576.0);
+        r.resistance, r.max_speed, patches, steps, r.ranks, r.seconds, r.peak_memory / 1048576.0,
+        r.total_peak_memory / 1048576.0);
     if (!f) fail("{}: write failed", json.string());
     f.close();
     out.commit();
@@ -435,13 +461,17 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
       "  pressure  drop inlet→outlet {:.3f} Pa; resistance {:.4f} Pa·s/mL\n"
       "  speed     max {:.3f} m/s\n"
       "  wall      shear stress mean {:.4f} Pa, max {:.4f} Pa; force {:.3e} N\n"
-      "  solve     {} continuation steps, {} nonlinear steps, {:.1f} s, peak {:.0f} MB\n"
+      "  solve     {} continuation steps, {} nonlinear steps, {:.1f} s, peak {}\n"
       "  wrote     {}",
       job.mesh.filename().string(), r.cells, r.nodes, r.inlet_area_mm2, r.inlet_perimeter_mm,
       r.d_in_mm, profile_name(job), r.reynolds, r.u_in, job.viscosity, job.density, r.flow_ml_s,
       r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance, r.max_speed, wall.mean_shear,
       wall.max_shear, (wall.pressure_force + wall.viscous_force).norm(), r.steps.size(), picard,
-      r.seconds, r.peak_memory / 1048576.0, fmt::join(r.written, "\n            "));
+      r.seconds,
+      r.ranks > 1 ? fmt::format("{:.0f} MB per rank, {:.0f} MB on {} ranks",
+                                r.peak_memory / 1048576.0, r.total_peak_memory / 1048576.0, r.ranks)
+                  : fmt::format("{:.0f} MB", r.peak_memory / 1048576.0),
+      fmt::join(r.written, "\n            "));
 }
 
 }  // namespace naris::ns

@@ -56,7 +56,9 @@ struct AirflowResult {
   std::vector<ContinuationStep> steps;
   std::size_t cells = 0, nodes = 0;
   double seconds = 0.0, restarted_from = 0.0;  // the checkpoint's Re, 0 without --restart
-  std::size_t peak_memory = 0;
+  int ranks = 1;                               // MPI ranks that shared the solve
+  std::size_t peak_memory = 0;                 // bytes, the largest of any rank
+  std::size_t total_peak_memory = 0;           // bytes, summed over the ranks
   std::vector<std::string> written;
 };
 

@@ -514,6 +514,11 @@ TEST_F(Cli, SolveOnTwoRanksMatchesOneRank) {
     EXPECT_TRUE(fs::exists(two / f)) << f;
   EXPECT_FALSE(fs::exists(two / "solution.vtu"));
   EXPECT_FALSE(fs::exists(one / "solution.pvtu"));
+  // Memory of every rank: the largest, and the sum, which two ranks make larger than either.
+  EXPECT_EQ(summary(one, "mpi_ranks"), 1.0);
+  EXPECT_EQ(summary(two, "mpi_ranks"), 2.0);
+  EXPECT_EQ(summary(one, "peak_memory_all_ranks_mb"), summary(one, "peak_memory_mb"));
+  EXPECT_GT(summary(two, "peak_memory_all_ranks_mb"), summary(two, "peak_memory_mb"));
 }
 
 TEST_F(Cli, SolveBadInput) {
