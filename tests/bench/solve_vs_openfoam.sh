@@ -2,7 +2,8 @@
 # naris solve on 1 and 2 MPI ranks against OpenFOAM's simpleFoam on the very same mesh (the
 # .msh export through gmshToFoam), laminar, same boundary conditions: uniform velocity normal
 # to the inlet, zero-gradient (traction-free) outlet at p = 0, no-slip walls. Prints the time to
-# solution of each, the ratios and the two inlet→outlet pressure drops (area averages).
+# solution of each, its peak memory, the ratios and the two inlet→outlet pressure drops (area
+# averages).
 # Usage: solve_vs_openfoam.sh NARIS MESH_H5 RE [WORK]
 #   MESH_H5: made by naris mesh, with mesh.msh beside it.
 set -euo pipefail
@@ -14,10 +15,13 @@ mkdir -p "$work"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 rho=1.2
 
-seconds() { /usr/bin/time -f %e -o "$1" "${@:2}"; }
+# Elapsed seconds and peak resident memory (KB) of a command, into file $1.
+seconds() { /usr/bin/time -f "%e %M" -o "$1" "${@:2}"; }
+# The last line: a failed command's file starts with its exit status.
+elapsed() { tail -1 "$1" | awk '{print $1}'; }
 field() { sed -n "s/.*\"$2\": \\([-0-9.e+]*\\).*/\\1/p" "$1" | head -1; }
 
-declare -A time dp steps
+declare -A time dp steps memory
 for ranks in 1 2; do
   out="$work/naris-$ranks"
   echo "naris solve, $ranks rank(s), Re $re ..." >&2
@@ -26,8 +30,14 @@ for ranks in 1 2; do
   seconds "$work/time-$ranks" "${launcher[@]}" "$naris" solve "$mesh" --re "$re" \
     --pseudo-cfl 5 --max-iterations 150 -o "$out" > "$work/naris-$ranks.log" 2>&1 ||
     { tail -5 "$work/naris-$ranks.log" >&2; echo "naris solve failed on $ranks rank(s)" >&2; }
-  time[$ranks]=$(cat "$work/time-$ranks")
+  time[$ranks]=$(elapsed "$work/time-$ranks")
   dp[$ranks]=$(field "$out/summary.json" pressure_drop_pa 2>/dev/null || echo nan)
+  # Per rank (the largest) and, on several ranks, summed over them: from naris's own summary,
+  # since time(1) under mpiexec would measure the launcher.
+  memory[$ranks]=$(awk -v m="$(field "$out/summary.json" peak_memory_mb)" \
+    -v all="$(field "$out/summary.json" peak_memory_all_ranks_mb)" -v n="$ranks" \
+    'BEGIN { if (m == "") print "?"; else if (n > 1) printf "%.0f/rank, %.0f", m, all;
+             else printf "%.0f", m }')
   steps[$ranks]=$(grep -o 'nonlinear_iterations": [0-9]*' "$out/summary.json" 2>/dev/null |
     awk '{s += $2} END {print s + 0}')
 done
@@ -108,7 +118,8 @@ DICT
   echo "simpleFoam, 1 core, Re $re ..." >&2
   seconds "$work/time-openfoam" simpleFoam > simpleFoam.log 2>&1 || true
 )
-time[openfoam]=$(cat "$work/time-openfoam")
+time[openfoam]=$(elapsed "$work/time-openfoam")
+memory[openfoam]=$(tail -1 "$work/time-openfoam" | awk '{printf "%.0f", $2 / 1024}')
 last() { awk '!/^#/ && NF {v = $2} END {print v}' "$1"; }
 p_in=$(last "$case"/postProcessing/inletPressure/0/surfaceFieldValue.dat)
 p_out=$(last "$case"/postProcessing/outletPressure/0/surfaceFieldValue.dat)
@@ -120,10 +131,13 @@ residuals=$(grep 'Solving for Ux' "$case/simpleFoam.log" | tail -1 |
 
 echo
 echo "Re $re on $(basename "$(dirname "$mesh")")/$(basename "$mesh"), U_in $u_in m/s"
-printf '%-22s %10s %12s %14s\n' solver "time (s)" "Δp (Pa)" "steps"
-printf '%-22s %10s %12s %14s\n' "naris, 1 rank" "${time[1]}" "${dp[1]}" "${steps[1]} nonlinear"
-printf '%-22s %10s %12s %14s\n' "naris, 2 ranks" "${time[2]}" "${dp[2]}" "${steps[2]} nonlinear"
-printf '%-22s %10s %12s   %s\n' "simpleFoam, 1 core" "${time[openfoam]}" "${dp[openfoam]}" "$converged"
+printf '%-22s %10s %12s %20s %14s\n' solver "time (s)" "Δp (Pa)" "peak memory (MB)" "steps"
+printf '%-22s %10s %12s %20s %14s\n' "naris, 1 rank" "${time[1]}" "${dp[1]}" "${memory[1]}" \
+  "${steps[1]} nonlinear"
+printf '%-22s %10s %12s %20s %14s\n' "naris, 2 ranks" "${time[2]}" "${dp[2]}" "${memory[2]}" \
+  "${steps[2]} nonlinear"
+printf '%-22s %10s %12s %20s   %s\n' "simpleFoam, 1 core" "${time[openfoam]}" "${dp[openfoam]}" \
+  "${memory[openfoam]}" "$converged"
 echo "  simpleFoam's last $residuals"
 # SIMPLE's pressure residual stalls near 2e-5 on these meshes while Δp no longer changes, so
 # residualControl may never stop it: also report when its Δp settled within 0.1 % of the last
