@@ -519,6 +519,11 @@ TEST_F(Cli, SolveOnTwoRanksMatchesOneRank) {
   EXPECT_EQ(summary(two, "mpi_ranks"), 2.0);
   EXPECT_EQ(summary(one, "peak_memory_all_ranks_mb"), summary(one, "peak_memory_mb"));
   EXPECT_GT(summary(two, "peak_memory_all_ranks_mb"), summary(two, "peak_memory_mb"));
+  // A serial run into the same folder replaces the pieces with one file.
+  ASSERT_EQ(naris("solve " + mesh.string() + " --re 40 -o " + two.string()).status, 0);
+  EXPECT_TRUE(fs::exists(two / "solution.vtu"));
+  for (const char* f : {"solution.pvtu", "solution_0.vtu", "solution_1.vtu"})
+    EXPECT_FALSE(fs::exists(two / f)) << f;
 }
 
 TEST_F(Cli, SolveBadInput) {
