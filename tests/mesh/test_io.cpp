@@ -43,6 +43,23 @@ fs::path temp_dir() {
   return d;
 }
 
+// A cell field holding each cell's index, to see where a cell went.
+CellFields cell_index_field(const HybridMesh& m) {
+  CellFields fields;
+  auto& index = fields["index"];
+  for (std::size_t c = 0; c < m.cell_count(); ++c) index.push_back(static_cast<double>(c));
+  return fields;
+}
+
+// A .vtu or .pvtu read back by VTK's own reader of that format.
+template <class Reader>
+vtkSmartPointer<vtkUnstructuredGrid> read_grid(const fs::path& path) {
+  auto reader = vtkSmartPointer<Reader>::New();
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  return reader->GetOutput();
+}
+
 TEST(MeshH5, RoundTripIsExact) {
   const HybridMesh m = sample_mesh();
   ASSERT_FALSE(m.tets.empty());
@@ -73,14 +90,8 @@ TEST(MeshH5, RejectsFilesThatAreNotMeshes) {
 TEST(Vtk, VtuAndStlReadBack) {
   const HybridMesh m = sample_mesh();
   const fs::path dir = temp_dir();
-  CellFields fields;
-  auto& index = fields["index"];
-  for (std::size_t c = 0; c < m.cell_count(); ++c) index.push_back(static_cast<double>(c));
-  write_vtu(m, dir / "mesh.vtu", fields);
-  auto reader = vtkSmartPointer<vtkXMLUnstructuredGridReader>::New();
-  reader->SetFileName((dir / "mesh.vtu").c_str());
-  reader->Update();
-  vtkUnstructuredGrid* grid = reader->GetOutput();
+  write_vtu(m, dir / "mesh.vtu", cell_index_field(m));
+  const auto grid = read_grid<vtkXMLUnstructuredGridReader>(dir / "mesh.vtu");
   ASSERT_EQ(grid->GetNumberOfCells(), static_cast<vtkIdType>(m.cell_count()));
   ASSERT_EQ(grid->GetNumberOfPoints(), static_cast<vtkIdType>(m.nodes.size()));
   const vtkIdType first_hex = static_cast<vtkIdType>(m.tets.size() + m.pyramids.size());
@@ -112,9 +123,7 @@ TEST(Vtk, PvtuPiecesCoverTheMeshOnce) {
   const HybridMesh m = sample_mesh();
   const fs::path dir = temp_dir() / "pvtu";
   fs::create_directories(dir);
-  CellFields cells;
-  auto& index = cells["index"];
-  for (std::size_t c = 0; c < m.cell_count(); ++c) index.push_back(static_cast<double>(c));
+  const CellFields cells = cell_index_field(m);
   PointFields points;
   auto& coordinates = points["x"];
   coordinates.components = 3;
@@ -136,10 +145,7 @@ TEST(Vtk, PvtuPiecesCoverTheMeshOnce) {
   for (int piece = 0; piece < kPieces; ++piece)
     EXPECT_TRUE(fs::exists(dir / ("flow_" + std::to_string(piece) + ".vtu"))) << piece;
 
-  auto reader = vtkSmartPointer<vtkXMLPUnstructuredGridReader>::New();
-  reader->SetFileName((dir / "flow.pvtu").c_str());
-  reader->Update();
-  vtkUnstructuredGrid* grid = reader->GetOutput();
+  const auto grid = read_grid<vtkXMLPUnstructuredGridReader>(dir / "flow.pvtu");
   ASSERT_EQ(grid->GetNumberOfCells(), static_cast<vtkIdType>(m.cell_count()));
   // Nodes on a piece boundary appear in each piece that uses them.
   EXPECT_GT(grid->GetNumberOfPoints(), static_cast<vtkIdType>(m.nodes.size()));
