@@ -37,10 +37,19 @@ HybridMesh sample_mesh() {
   return mve::march_volume_elements(f, testing::quiet_options());
 }
 
+// This process's scratch folder, removed when the process ends (ctest runs every test in a
+// process of its own; a folder per pid kept would pile up in /tmp).
 fs::path temp_dir() {
-  const fs::path d = fs::temp_directory_path() / ("naris-io-" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
+  struct Scratch {
+    fs::path path = fs::temp_directory_path() / ("naris-io-" + std::to_string(::getpid()));
+    Scratch() { fs::create_directories(path); }
+    ~Scratch() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  };
+  static const Scratch scratch;
+  return scratch.path;
 }
 
 // A cell field holding each cell's index, to see where a cell went.
