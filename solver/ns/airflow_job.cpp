@@ -359,8 +359,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   }
   // Memory: the largest rank's peak is what each machine of a cluster must have, the sum what
   // the run took in all.
+  const auto mine = static_cast<unsigned long long>(peak_memory_bytes());
   {
-    const auto mine = static_cast<unsigned long long>(peak_memory_bytes());
     unsigned long long largest = mine, sum = mine;
     MPI_Allreduce(&mine, &largest, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, PETSC_COMM_WORLD);
     MPI_Allreduce(&mine, &sum, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, PETSC_COMM_WORLD);
@@ -393,9 +393,9 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   write_residual_history();
   r.written.push_back(csv.string());
   r.seconds = total.seconds();
-  // The first rank also wrote the files: its own peak may have grown since.
+  // The first rank also wrote the files: its own peak may have grown since (a peak only grows).
   const std::size_t own = peak_memory_bytes();
-  r.total_peak_memory += own - std::min(own, r.peak_memory);
+  r.total_peak_memory += own - std::min<std::size_t>(own, mine);
   r.peak_memory = std::max(r.peak_memory, own);
 
   const fs::path json = job.output / "summary.json";
