@@ -100,13 +100,7 @@ bool up_to_date(const Stage& s, const fs::path& stamp) {
 }
 
 void write_stamp(const Stage& s, const fs::path& stamp) {
-  AtomicOutput out(stamp);
-  {
-    std::ofstream f(out.temp_path());
-    f << s.settings;
-    if (!f) fail("{}: cannot write", stamp.string());
-  }
-  out.commit();
+  write_text_file(stamp, s.settings);
 }
 
 struct RunOptions {

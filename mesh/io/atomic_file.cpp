@@ -29,6 +29,17 @@ void AtomicOutput::commit() {
   committed_ = true;
 }
 
+void write_text_file(const fs::path& path, std::string_view text) {
+  AtomicOutput out(path);
+  {
+    std::ofstream f(out.temp_path(), std::ios::binary);
+    f.write(text.data(), static_cast<std::streamsize>(text.size()));
+    f.flush();
+    if (!f) fail("{}: write failed (disk full?)", path.string());
+  }
+  out.commit();
+}
+
 void ensure_writable_folder(const fs::path& folder) {
   const fs::path dir = folder.empty() ? fs::path(".") : folder;
   std::error_code ec;

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -54,9 +53,7 @@ void write_xdmf(const HybridMesh& mesh, const fs::path& h5_path) {
   x << " </Grid>\n </Domain>\n</Xdmf>\n";
 
   const fs::path xdmf = fs::path(h5_path).replace_extension(".xdmf");
-  AtomicOutput out(xdmf);
-  std::ofstream(out.temp_path()) << x.str();
-  out.commit();
+  write_text_file(xdmf, x.str());
 }
 
 }  // namespace

@@ -278,14 +278,7 @@ void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path,
   for (int k = 0; k < pieces; ++k)
     xml += fmt::format("  <Piece Source=\"{}\"/>\n", pvtu_piece_path(path, k).filename().string());
   xml += " </PUnstructuredGrid>\n</VTKFile>\n";
-  AtomicOutput out(path);
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(out.temp_path().c_str(), "wb"),
-                                                       &std::fclose);
-  if (!file || std::fwrite(xml.data(), 1, xml.size(), file.get()) != xml.size() ||
-      std::fflush(file.get()) != 0)
-    fail("{}: write failed", path.string());
-  file.reset();
-  out.commit();
+  write_text_file(path, xml);
 }
 
 namespace {

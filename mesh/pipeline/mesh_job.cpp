@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <set>
 
 #include "core/error.h"
@@ -208,9 +207,7 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
       r.improvement.refused_topology, r.improvement.refused_geometry, r.improvement.removed_cells,
       r.improvement.pyramids_to_tets, patches, quality_json(r.before), quality_json(r.after),
       seconds, static_cast<double>(peak_memory_bytes()) / 1e6);
-  AtomicOutput out(sibling("mesh.json"));
-  std::ofstream(out.temp_path()) << json;
-  out.commit();
+  write_text_file(sibling("mesh.json"), json);
   r.written.push_back(sibling("mesh.json").string());
 }
 

@@ -418,29 +418,27 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
           patches.empty() ? "" : ",", p.name, p.area_mm2, p.pressure_force[0], p.pressure_force[1],
           p.pressure_force[2], p.viscous_force[0], p.viscous_force[1], p.viscous_force[2],
           p.mean_shear, p.max_shear);
-    AtomicOutput out(json);
-    std::ofstream f(out.temp_path());
-    f << fmt::format(
-        "{{\n  \"mesh\": {},\n  \"cells\": {},\n  \"nodes\": {},\n  \"reynolds\": {:.6g},\n"
-        "  \"inlet_speed_m_s\": {:.6g},\n  \"inlet_hydraulic_diameter_mm\": {:.6g},\n"
-        "  \"inlet_area_mm2\": {:.6g},\n  \"inlet_perimeter_mm\": {:.6g},\n"
-        "  \"viscosity_m2_s\": {:.6g},\n  \"density_kg_m3\": {:.6g},\n  \"inlet_profile\": "
-        "{},\n"
-        "  \"flow_ml_s\": {:.6g},\n  \"outlet_flow_ml_s\": {:.6g},\n  \"pressure_drop_pa\": "
-        "{:.6g},\n"
-        "  \"resistance_pa_s_ml\": {:.6g},\n  \"max_speed_m_s\": {:.6g},\n  \"patches\": [{}\n  "
-        "],\n"
-        "  \"continuation\": [{}],\n"
-        "  \"mpi_ranks\": {},\n  \"seconds\": {:.3f},\n  \"peak_memory_mb\": {:.1f},\n"
-        "  \"peak_memory_all_ranks_mb\": {:.1f}\n}}\n",
-        json_string(job.mesh.string()), r.cells, r.nodes, r.reynolds, r.u_in, r.d_in_mm,
-        r.inlet_area_mm2, r.inlet_perimeter_mm, job.viscosity, job.density,
-        json_string(profile_name(job)), r.flow_ml_s, r.outlet_flow_ml_s, r.pressure_drop_pa,
-        r.resistance, r.max_speed, patches, steps, r.ranks, r.seconds, r.peak_memory / 1048576.0,
-        r.total_peak_memory / 1048576.0);
-    if (!f) fail("{}: write failed", json.string());
-    f.close();
-    out.commit();
+    write_text_file(
+        json,
+        fmt::format(
+            "{{\n  \"mesh\": {},\n  \"cells\": {},\n  \"nodes\": {},\n  \"reynolds\": {:.6g},\n"
+            "  \"inlet_speed_m_s\": {:.6g},\n  \"inlet_hydraulic_diameter_mm\": {:.6g},\n"
+            "  \"inlet_area_mm2\": {:.6g},\n  \"inlet_perimeter_mm\": {:.6g},\n"
+            "  \"viscosity_m2_s\": {:.6g},\n  \"density_kg_m3\": {:.6g},\n  \"inlet_profile\": "
+            "{},\n"
+            "  \"flow_ml_s\": {:.6g},\n  \"outlet_flow_ml_s\": {:.6g},\n  \"pressure_drop_pa\": "
+            "{:.6g},\n"
+            "  \"resistance_pa_s_ml\": {:.6g},\n  \"max_speed_m_s\": {:.6g},\n  \"patches\": [{}\n "
+            " "
+            "],\n"
+            "  \"continuation\": [{}],\n"
+            "  \"mpi_ranks\": {},\n  \"seconds\": {:.3f},\n  \"peak_memory_mb\": {:.1f},\n"
+            "  \"peak_memory_all_ranks_mb\": {:.1f}\n}}\n",
+            json_string(job.mesh.string()), r.cells, r.nodes, r.reynolds, r.u_in, r.d_in_mm,
+            r.inlet_area_mm2, r.inlet_perimeter_mm, job.viscosity, job.density,
+            json_string(profile_name(job)), r.flow_ml_s, r.outlet_flow_ml_s, r.pressure_drop_pa,
+            r.resistance, r.max_speed, patches, steps, r.ranks, r.seconds,
+            r.peak_memory / 1048576.0, r.total_peak_memory / 1048576.0));
   }
   r.written.push_back(json.string());
   r.written.push_back(checkpoint.string());

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <fstream>
 #include <sstream>
 #include <vector>
 
@@ -77,9 +76,7 @@ void write_xdmf(const HybridMesh& mesh, const fs::path& h5, const fs::path& mesh
   grid("pyramids", "Pyramid", mesh.pyramids.size(), 5, "/cells/pyramid");
   grid("hexahedra", "Hexahedron", mesh.hexes.size(), 8, "/cells/hex");
   x << " </Grid>\n </Domain>\n</Xdmf>\n";
-  AtomicOutput out(fs::path(h5).replace_extension(".xdmf"));
-  std::ofstream(out.temp_path()) << x.str();
-  out.commit();
+  write_text_file(fs::path(h5).replace_extension(".xdmf"), x.str());
 }
 
 }  // namespace
