@@ -60,6 +60,18 @@ vtkSmartPointer<vtkCellArray> make_cell_array(std::vector<vtkIdType>& offsets,
   return cells;
 }
 
+void check_field_sizes(const HybridMesh& mesh, const CellFields& cell_fields,
+                       const PointFields& point_fields) {
+  for (const auto& [name, values] : cell_fields)
+    if (values.size() != mesh.cell_count())
+      fail("internal: cell field '{}' has {} values for {} cells", name, values.size(),
+           mesh.cell_count());
+  for (const auto& [name, field] : point_fields)
+    if (field.values.size() != static_cast<std::size_t>(field.components) * mesh.nodes.size())
+      fail("internal: point field '{}' has {} values for {} nodes", name, field.values.size(),
+           mesh.nodes.size());
+}
+
 template <class Writer>
 void run_writer(Writer* writer, const std::filesystem::path& path) {
   AtomicOutput out(path);
@@ -75,14 +87,8 @@ void run_writer(Writer* writer, const std::filesystem::path& path) {
 // is ~40× slower). The tests read it back with VTK's reader.
 void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
                const CellFields& cell_fields, const PointFields& point_fields) {
+  check_field_sizes(mesh, cell_fields, point_fields);
   const std::size_t cells = mesh.cell_count();
-  for (const auto& [name, values] : cell_fields)
-    if (values.size() != cells)
-      fail("internal: cell field '{}' has {} values for {} cells", name, values.size(), cells);
-  for (const auto& [name, field] : point_fields)
-    if (field.values.size() != static_cast<std::size_t>(field.components) * mesh.nodes.size())
-      fail("internal: point field '{}' has {} values for {} nodes", name, field.values.size(),
-           mesh.nodes.size());
   const std::uint64_t points_bytes = 3 * sizeof(double) * mesh.nodes.size();
   const std::uint64_t conn_bytes =
       sizeof(NodeId) * (4 * mesh.tets.size() + 5 * mesh.pyramids.size() + 8 * mesh.hexes.size());
@@ -196,8 +202,9 @@ std::filesystem::path pvtu_piece_path(const std::filesystem::path& path, int pie
 }
 
 void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path, int piece,
-                      int pieces, const std::function<bool(std::size_t)>& owned,
-                      const CellFields& cell_fields, const PointFields& point_fields) {
+                      int pieces, const CellPredicate& owned, const CellFields& cell_fields,
+                      const PointFields& point_fields) {
+  check_field_sizes(mesh, cell_fields, point_fields);
   // The piece as a mesh of its own (nodes renumbered in their global order) and, for every
   // piece node and cell, where its values are in the whole mesh's fields.
   HybridMesh part;
@@ -206,7 +213,7 @@ void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path,
   std::size_t c = 0;
   auto take = [&](const auto& from, auto& to) {
     for (const auto& cell : from) {
-      if (owned(c)) {
+      if (owned(std::span<const NodeId>(cell))) {
         cells.push_back(c);
         to.push_back(cell);
         for (NodeId n : cell) local[static_cast<std::size_t>(n)] = 0;
@@ -234,9 +241,6 @@ void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path,
 
   CellFields part_cells;
   for (const auto& [name, values] : cell_fields) {
-    if (values.size() != mesh.cell_count())
-      fail("internal: cell field '{}' has {} values for {} cells", name, values.size(),
-           mesh.cell_count());
     auto& v = part_cells[name];
     v.reserve(cells.size());
     for (std::size_t k : cells) v.push_back(values[k]);
@@ -244,9 +248,6 @@ void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path,
   PointFields part_points;
   for (const auto& [name, field] : point_fields) {
     const auto m = static_cast<std::size_t>(field.components);
-    if (field.values.size() != m * mesh.nodes.size())
-      fail("internal: point field '{}' has {} values for {} nodes", name, field.values.size(),
-           mesh.nodes.size());
     auto& f = part_points[name];
     f.components = field.components;
     f.values.reserve(m * global.size());

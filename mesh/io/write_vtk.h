@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -22,13 +23,14 @@ using PointFields = std::map<std::string, PointField>;
 
 void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
                const CellFields& cell_fields = {}, const PointFields& point_fields = {});
-// One piece of a parallel VTK file (.pvtu): the cells c (in the writer's order) for which
-// owned(c) holds, with the fields restricted to them, written as <stem>_<piece>.vtu beside
-// `path`; piece 0 also writes the .pvtu index naming all `pieces`. Fields are given on the whole
-// mesh, as for write_vtu. Each piece is written by its own rank, in parallel.
+// One piece of a parallel VTK file (.pvtu): the cells whose nodes satisfy owned(nodes), with
+// the fields restricted to them, written as <stem>_<piece>.vtu beside `path`; piece 0 also
+// writes the .pvtu index naming all `pieces`. Fields are given on the whole mesh, as for
+// write_vtu. Each piece is written by its own rank, in parallel.
+using CellPredicate = std::function<bool(std::span<const NodeId>)>;
 void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path, int piece,
-                      int pieces, const std::function<bool(std::size_t)>& owned,
-                      const CellFields& cell_fields = {}, const PointFields& point_fields = {});
+                      int pieces, const CellPredicate& owned, const CellFields& cell_fields = {},
+                      const PointFields& point_fields = {});
 std::filesystem::path pvtu_piece_path(const std::filesystem::path& path, int piece);
 // Face fields are given per boundary face: triangles, then quadrilaterals.
 void write_boundary_vtp(const HybridMesh& mesh, const std::filesystem::path& path,

@@ -334,20 +334,14 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     r.written.push_back(vtu.string());
   } else {
     const parallel::NodeRange range = parallel::owned_nodes(mesh.nodes.size(), rank, ranks);
-    const std::size_t tets = mesh.tets.size(), pyramids = mesh.pyramids.size();
     // A rank that cannot write its piece (disk full) must not leave the others waiting in the
     // reductions below: every rank learns that one failed.
     std::string failure;
     try {
       write_pvtu_piece(
           mesh, pvtu, rank, ranks,
-          [&](std::size_t c) {
-            return c < tets ? parallel::owns_cell(range, mesh.tets[c])
-                   : c < tets + pyramids
-                       ? parallel::owns_cell(range, mesh.pyramids[c - tets])
-                       : parallel::owns_cell(range, mesh.hexes[c - tets - pyramids]);
-          },
-          {}, fields);
+          [&](std::span<const NodeId> cell) { return parallel::owns_cell(range, cell); }, {},
+          fields);
     } catch (const Error& e) {
       failure = e.what();
     }
