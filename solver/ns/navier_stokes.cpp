@@ -51,9 +51,8 @@ class OseenSystem {
     MPI_Comm_size(comm, &size);
     rank_ = rank;
     const auto n = static_cast<std::int64_t>(mesh.nodes.size());
-    const parallel::NodeRange range = parallel::owned_nodes(mesh.nodes.size(), rank, size);
-    lo_ = range.first;
-    hi_ = range.end;
+    owned_ = parallel::owned_nodes(mesh.nodes.size(), rank, size);
+    const NodeId lo = owned_.first, hi = owned_.end;
     if (size > 1) {
       owned_cells(mesh.tets, owned_tets_);
       owned_cells(mesh.pyramids, owned_pyramids_);
@@ -61,7 +60,7 @@ class OseenSystem {
       // The recovered gradient and lumped mass are needed at the owned nodes and at every node
       // of an owned cell; each of those takes all the cells around it.
       std::vector<char> needed(mesh.nodes.size(), 0);
-      std::fill(needed.begin() + lo_, needed.begin() + hi_, 1);
+      std::fill(needed.begin() + lo, needed.begin() + hi, 1);
       auto mark = [&](const auto& cells, const std::vector<std::size_t>& owned) {
         for (std::size_t c : owned)
           for (NodeId v : cells[c]) needed[static_cast<std::size_t>(v)] = 1;
@@ -80,16 +79,16 @@ class OseenSystem {
       touching(mesh.hexes, halo_hexes_);
     }
     all_cells_ = size == 1;
-    const auto graph = node_graph(mesh, lo_, hi_);
-    const PetscInt local = hi_ - lo_;
+    const auto graph = node_graph(mesh, lo, hi);
+    const PetscInt local = hi - lo;
     std::vector<PetscInt> diagonal(static_cast<std::size_t>(local)),
         off_diagonal(static_cast<std::size_t>(local));
-    for (NodeId i = lo_; i < hi_; ++i) {
-      const auto& row = graph[static_cast<std::size_t>(i - lo_)];
+    for (NodeId i = lo; i < hi; ++i) {
+      const auto& row = graph[static_cast<std::size_t>(i - lo)];
       const auto inside =
-          std::count_if(row.begin(), row.end(), [&](NodeId j) { return j >= lo_ && j < hi_; });
-      diagonal[static_cast<std::size_t>(i - lo_)] = static_cast<PetscInt>(inside);
-      off_diagonal[static_cast<std::size_t>(i - lo_)] =
+          std::count_if(row.begin(), row.end(), [&](NodeId j) { return owned_.contains(j); });
+      diagonal[static_cast<std::size_t>(i - lo)] = static_cast<PetscInt>(inside);
+      off_diagonal[static_cast<std::size_t>(i - lo)] =
           static_cast<PetscInt>(row.size()) - static_cast<PetscInt>(inside);
     }
     check(MatCreate(comm, matrix_.out()), "MatCreate");
@@ -117,9 +116,7 @@ class OseenSystem {
     check(VecScatterCreateToAll(rhs_, gather_.out(), whole_.out()), "VecScatterCreateToAll");
   }
 
-  NodeId first_node() const { return lo_; }
-  NodeId end_node() const { return hi_; }
-  bool owns(NodeId node) const { return node >= lo_ && node < hi_; }
+  bool owns(NodeId node) const { return owned_.contains(node); }
   int rank() const { return rank_; }
 
   // v's values at every node, on every rank.
@@ -139,8 +136,8 @@ class OseenSystem {
   void distribute(const FlowField& field, Vec v) const {
     PetscScalar* x = nullptr;
     check(VecGetArray(v, &x), "VecGetArray");
-    for (NodeId k = lo_; k < hi_; ++k) {
-      const auto i = static_cast<std::size_t>(k - lo_), g = static_cast<std::size_t>(k);
+    for (NodeId k = owned_.first; k < owned_.end; ++k) {
+      const auto i = static_cast<std::size_t>(k - owned_.first), g = static_cast<std::size_t>(k);
       for (int c = 0; c < 3; ++c) x[4 * i + static_cast<std::size_t>(c)] = field.velocity[g][c];
       x[4 * i + 3] = field.pressure[g];
     }
@@ -198,8 +195,8 @@ class OseenSystem {
     PetscScalar* d = nullptr;
     check(VecSet(scratch_, 0.0), "VecSet");
     check(VecGetArray(scratch_, &d), "VecGetArray");
-    for (NodeId k = lo_; k < hi_; ++k) {
-      const auto n = static_cast<std::size_t>(k), i = static_cast<std::size_t>(k - lo_);
+    for (NodeId k = owned_.first; k < owned_.end; ++k) {
+      const auto n = static_cast<std::size_t>(k), i = static_cast<std::size_t>(k - owned_.first);
       const double m = lumped_mass_[n];
       if (!(m > 0.0)) continue;
       const double h = std::cbrt(m);
@@ -309,7 +306,7 @@ class OseenSystem {
   template <class Cells>
   void owned_cells(const Cells& cells, std::vector<std::size_t>& owned) const {
     for (std::size_t c = 0; c < cells.size(); ++c)
-      if (parallel::owns_cell({lo_, hi_}, cells[c])) owned.push_back(c);
+      if (parallel::owns_cell(owned_, cells[c])) owned.push_back(c);
   }
 
   template <class E, class Cells, class Force>
@@ -353,8 +350,8 @@ class OseenSystem {
   double backflow_beta_ = 0.0;
   petsc::Matrix matrix_;
   int rank_ = 0;
-  NodeId lo_ = 0, hi_ = 0;  // the owned nodes
-  bool all_cells_ = true;   // one rank: every cell, no lists
+  parallel::NodeRange owned_;  // the nodes whose rows this rank holds
+  bool all_cells_ = true;      // one rank: every cell, no lists
   std::vector<std::size_t> owned_tets_, owned_pyramids_, owned_hexes_;  // assembled here
   std::vector<std::size_t> halo_tets_, halo_pyramids_, halo_hexes_;     // for the gradient
   petsc::Vector rhs_, solution_, residual_, scratch_, whole_;
