@@ -238,6 +238,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       log_line(fmt::format("  Re {:.1f}: {}", re, e.what()));
     }
     cs.iterations = report.iterations;
+    cs.linear_iterations = report.linear_iterations;
+    cs.preconditioner_builds = report.preconditioner_builds;
     cs.residuals = report.residuals;
     cs.residual = report.residuals.empty() ? NAN : report.residuals.back();
     cs.seconds = clock.seconds();
@@ -398,10 +400,10 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     for (const auto& s : r.steps)
       steps += fmt::format(
           "{}{{\"reynolds\": {:.6g}, \"converged\": {}, \"nonlinear_iterations\": {}, "
-          "\"residual\": "
-          "{:.6e}, \"seconds\": {:.3f}}}",
+          "\"linear_iterations\": {}, \"preconditioner_builds\": {}, \"residual\": {:.6e}, "
+          "\"seconds\": {:.3f}}}",
           steps.empty() ? "" : ", ", s.reynolds, s.converged ? "true" : "false", s.iterations,
-          s.residual, s.seconds);
+          s.linear_iterations, s.preconditioner_builds, s.residual, s.seconds);
     std::string patches;
     for (const auto& p : r.patches)
       patches += fmt::format(

@@ -36,6 +36,7 @@ struct ContinuationStep {
   double reynolds = 0.0;
   bool converged = false;
   int iterations = 0;
+  int linear_iterations = 0, preconditioner_builds = 0;
   double residual = 0.0, seconds = 0.0;
   std::vector<double> residuals;
 };

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "ns/oseen_element.h"
+#include "ns/preconditioner_reuse.h"
 #include "ns/segregated_step.h"
 #include "parallel/partition.h"
 #include "parallel/petsc.h"
@@ -439,7 +440,13 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
     }
   }
   check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
+  PetscInt max_linear_iterations = 0;  // as set, by default or from the command line
+  check(KSPGetTolerances(ksp, nullptr, nullptr, nullptr, &max_linear_iterations),
+        "KSPGetTolerances");
 
+  // Any preconditioner of the coupled system may be kept; the segregated sweeps set theirs up
+  // themselves.
+  PreconditionerReuse reuse(options.reuse_preconditioner && options.scheme == Scheme::coupled);
   PicardReport local;
   PicardReport& r = report ? *report : local;
   r = {};
@@ -558,12 +565,48 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
       linear = fmt::format("{} momentum and {} pressure iterations", sweep->momentum_iterations(),
                            sweep->pressure_iterations());
     } else {
-      check(KSPSetOperators(ksp, system.matrix(), system.matrix()), "KSPSetOperators");
-      check(KSPSolve(ksp, system.rhs(), system.solution()), "KSPSolve");
-      check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
-      PetscInt its = 0;
-      check(KSPGetIterationNumber(ksp, &its), "KSPGetIterationNumber");
-      linear = fmt::format("{} linear iterations", its);
+      const auto kind = stokes   ? LinearProblem::stokes
+                        : newton ? LinearProblem::newton
+                                 : LinearProblem::picard;
+      PetscInt its = 0, abandoned = 0;  // abandoned: those of a kept preconditioner's try
+      bool rebuilt = false;
+      // A solve that fails or runs over its budget with a kept preconditioner is retried with a
+      // fresh one; a failure with a fresh one is the linear solver's.
+      for (bool rebuild = !reuse.keeps(kind);; rebuild = true) {
+        check(KSPSetOperators(ksp, system.matrix(), system.matrix()), "KSPSetOperators");
+        check(KSPSetReusePreconditioner(ksp, rebuild ? PETSC_FALSE : PETSC_TRUE),
+              "KSPSetReusePreconditioner");
+        check(KSPSetTolerances(
+                  ksp, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT,
+                  rebuild ? max_linear_iterations
+                          : std::min<PetscInt>(max_linear_iterations, reuse.iteration_budget())),
+              "KSPSetTolerances");
+        Stopwatch setup;
+        check(KSPSetUp(ksp), "KSPSetUp");  // the factorization, when it is rebuilt
+        const double setup_seconds = setup.seconds();
+        Stopwatch solve;
+        check(KSPSolve(ksp, system.rhs(), system.solution()), "KSPSolve");
+        check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
+        check(KSPGetIterationNumber(ksp, &its), "KSPGetIterationNumber");
+        r.linear_iterations += static_cast<int>(its);
+        // The ranks time differently; they must still decide alike.
+        double seconds[2] = {setup_seconds, solve.seconds()};
+        MPI_Allreduce(MPI_IN_PLACE, seconds, 2, MPI_DOUBLE, MPI_MAX, comm);
+        if (rebuild) {
+          reuse.built(kind, seconds[0], seconds[1], static_cast<int>(its));
+          ++r.preconditioner_builds;
+          rebuilt = true;
+        } else {
+          reuse.kept(seconds[1], static_cast<int>(its));
+          abandoned = its;
+        }
+        if (reason >= 0 || rebuild) break;
+      }
+      linear = fmt::format("{} linear iterations{}", its,
+                           !rebuilt ? " (preconditioner kept)"
+                           : abandoned > 0
+                               ? fmt::format(" (after {} with the kept preconditioner)", abandoned)
+                               : "");
     }
     check(VecAYPX(system.solution(), 1.0, current), "VecAYPX");
     ++solves;

@@ -17,6 +17,7 @@
 #include "meshes.h"
 #include "ns/navier_stokes.h"
 #include "ns/oseen_element.h"
+#include "ns/preconditioner_reuse.h"
 #include "parallel/petsc.h"
 
 namespace naris::ns {
@@ -203,6 +204,61 @@ TEST(NavierStokes, StalledIterationGivesUpEarly) {
   const auto& h = report.residuals;
   EXPECT_GT(h.back(), 0.5 * h[h.size() - 5]);  // the reason it stopped
   EXPECT_LT(h.back(), h.front());              // still falling: only slowly
+}
+
+// Keeping the preconditioner changes the linear iterations, not the answer: Newton on the
+// Beltrami ball to 1e-10 with and without it. Without, every linear solve (the Stokes one and
+// one per nonlinear step) builds its own.
+TEST(NavierStokes, KeptPreconditionerReachesTheSameSolution) {
+  const BeltramiBall problem;
+  PicardOptions fresh, kept;
+  for (PicardOptions* o : {&fresh, &kept}) o->tolerance = 1e-10;
+  fresh.reuse_preconditioner = false;
+  PicardReport fresh_report, kept_report;
+  const FlowField a = solve_navier_stokes(problem.mesh, problem.nu, problem.force, problem.bc,
+                                          fresh, &fresh_report);
+  const FlowField b =
+      solve_navier_stokes(problem.mesh, problem.nu, problem.force, problem.bc, kept, &kept_report);
+  ASSERT_TRUE(fresh_report.converged);
+  ASSERT_TRUE(kept_report.converged);
+  EXPECT_EQ(fresh_report.preconditioner_builds, fresh_report.iterations + 1);
+  EXPECT_LE(kept_report.preconditioner_builds, kept_report.iterations + 1);
+  EXPECT_GT(kept_report.linear_iterations, 0);
+  std::printf("[ info ] preconditioner builds: %d of %d solves fresh, %d of %d kept\n",
+              fresh_report.preconditioner_builds, fresh_report.iterations + 1,
+              kept_report.preconditioner_builds, kept_report.iterations + 1);
+  double scale = 0.0, du = 0.0, dp = 0.0, pscale = 0.0;
+  for (std::size_t k = 0; k < a.velocity.size(); ++k) {
+    scale = std::max(scale, a.velocity[k].norm());
+    pscale = std::max(pscale, std::abs(a.pressure[k]));
+    du = std::max(du, (a.velocity[k] - b.velocity[k]).norm());
+    dp = std::max(dp, std::abs(a.pressure[k] - b.pressure[k]));
+  }
+  EXPECT_LT(du, 1e-7 * scale);
+  EXPECT_LT(dp, 1e-7 * pscale);
+}
+
+// The rule itself, on made-up timings: a build costs 2 s, a fresh solve 100 iterations of
+// 10 ms. A kept preconditioner stays while the iterations it adds cost less than a build.
+TEST(PreconditionerReuse, KeepsWhileTheAddedIterationsCostLessThanABuild) {
+  PreconditionerReuse reuse(true);
+  EXPECT_FALSE(reuse.keeps(LinearProblem::stokes));  // nothing built yet
+  reuse.built(LinearProblem::newton, 2.0, 1.0, 100);
+  EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
+  EXPECT_FALSE(reuse.keeps(LinearProblem::picard));  // another kind of matrix
+  EXPECT_EQ(reuse.iteration_budget(), 100 + 200 + 1);
+  reuse.kept(1.5, 150);  // 50 more, 0.5 s < 2 s
+  EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
+  reuse.kept(3.0, 300);  // 200 more, exactly a build: still kept
+  EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
+  reuse.kept(3.1, 310);  // 210 more, 2.1 s > 2 s
+  EXPECT_FALSE(reuse.keeps(LinearProblem::newton));
+  reuse.built(LinearProblem::newton, 2.0, 1.0, 100);
+  EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
+
+  PreconditionerReuse off(false);
+  off.built(LinearProblem::newton, 2.0, 1.0, 100);
+  EXPECT_FALSE(off.keeps(LinearProblem::newton));
 }
 
 // The Newton matrix is the derivative of the element residual: against central differences of
