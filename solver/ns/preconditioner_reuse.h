@@ -28,10 +28,10 @@ class PreconditionerReuse {
     if (iterations > 0) seconds_per_iteration_ = solve_seconds / iterations;
     stale_ = (iterations - fresh_iterations_) * seconds_per_iteration_ > setup_seconds_;
   }
-  // Iterations a solve with the kept preconditioner may take before it is cheaper to stop,
-  // rebuild and solve again: a kept factorization then costs at most one build more than a
-  // fresh one (on the neonatal airway a kept ILU once took 276 iterations where a fresh one
-  // took 91).
+  // Iterations a solve with the kept preconditioner may take before it stops and is redone
+  // with a fresh one: the iterations of a fresh solve plus a build's worth, so a kept
+  // factorization that went bad costs at most twice what rebuilding at once would have (on the
+  // neonatal airway a kept ILU once took 276 iterations where a fresh one took 91).
   int iteration_budget() const {
     const double extra = setup_seconds_ / std::max(seconds_per_iteration_, 1e-12);
     return fresh_iterations_ + static_cast<int>(std::min(extra, 1e6)) + 1;
