@@ -601,6 +601,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
           abandoned = its;
         }
         if (reason >= 0 || rebuild) break;
+        reuse.abandoned();
       }
       linear = fmt::format("{} linear iterations{}", its,
                            !rebuilt ? " (preconditioner kept)"

@@ -58,9 +58,10 @@ struct PicardOptions {
   double velocity_relaxation = 0.7, pressure_relaxation = 0.3;
   std::string options_prefix = "ns_";
   // Keep the preconditioner (the ILU factors) from one nonlinear step to the next while that
-  // pays: it is rebuilt when the linearization changes kind (Stokes, Picard, Newton), when a
-  // solve with the old one fails, and when the iterations it added over the first solve after
-  // the last rebuild cost more time than a rebuild (both measured). The converged answer is
+  // pays: it is rebuilt when the linearization changes kind (Stokes, Picard, Newton), and when
+  // the iterations it added over the first solve after the last rebuild cost more time than a
+  // rebuild (both measured); once a solve with a kept one runs out of its iteration budget or
+  // fails, every later solve of this call rebuilds. The converged answer is
   // the same either way; only the linear iterations differ.
   bool reuse_preconditioner = true;
   // The ranks that share the system (MPI_COMM_NULL: PETSC_COMM_WORLD); each needs the whole

@@ -9,7 +9,8 @@ namespace naris::ns {
 // went to the factorizations), and consecutive Picard or Newton matrices differ little near
 // the solution; but a kept factorization costs iterations as the matrix drifts away from it.
 // It is rebuilt for a new kind of linearization, and once the iterations the last solve added
-// over the first one after the build cost more time than a build.
+// over the first one after the build cost more time than a build; after a kept solve has run
+// out of its budget, it is no longer kept at all (for the rest of that nonlinear solve).
 enum class LinearProblem { stokes, picard, newton };
 
 class PreconditionerReuse {
@@ -28,6 +29,10 @@ class PreconditionerReuse {
     if (iterations > 0) seconds_per_iteration_ = solve_seconds / iterations;
     stale_ = (iterations - fresh_iterations_) * seconds_per_iteration_ > setup_seconds_;
   }
+  // A kept solve ran out of its budget (or failed): the matrices change too fast for keeping
+  // to pay (under pseudo-time on the neonatal airway near Re 470 every other kept solve ran out,
+  // each wasting a whole solve to save a build), so every later solve builds its own.
+  void abandoned() { enabled_ = false; }
   // Iterations a solve with the kept preconditioner may take before it stops and is redone
   // with a fresh one: the iterations of a fresh solve plus a build's worth, so a kept
   // factorization that went bad costs at most twice what rebuilding at once would have (on the

@@ -255,6 +255,9 @@ TEST(PreconditionerReuse, KeepsWhileTheAddedIterationsCostLessThanABuild) {
   EXPECT_FALSE(reuse.keeps(LinearProblem::newton));
   reuse.built(LinearProblem::newton, 2.0, 1.0, 100);
   EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
+  reuse.abandoned();  // a kept solve ran out of its budget: no more keeping
+  reuse.built(LinearProblem::newton, 2.0, 1.0, 100);
+  EXPECT_FALSE(reuse.keeps(LinearProblem::newton));
 
   PreconditionerReuse off(false);
   off.built(LinearProblem::newton, 2.0, 1.0, 100);
