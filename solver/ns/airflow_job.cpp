@@ -78,6 +78,83 @@ void remove_stale_volume_files(const fs::path& vtu, const fs::path& pvtu, int ra
     fs::remove(pvtu_piece_path(pvtu, k), ignored);
 }
 
+// The boundary faces of `mesh` and their nodes only, in the same face order: boundary.vtp
+// without the interior points, and what the rank that writes it keeps of the whole mesh.
+HybridMesh boundary_surface(const HybridMesh& mesh) {
+  HybridMesh s;
+  s.patch_names = mesh.patch_names;
+  std::vector<NodeId> local(mesh.nodes.size(), -1);
+  auto take = [&](const auto& faces, auto& out) {
+    for (auto f : faces) {
+      for (NodeId& v : f) {
+        auto& l = local[static_cast<std::size_t>(v)];
+        if (l < 0) {
+          l = static_cast<NodeId>(s.nodes.size());
+          s.nodes.push_back(mesh.nodes[static_cast<std::size_t>(v)]);
+        }
+        v = l;
+      }
+      out.push_back(f);
+    }
+  };
+  take(mesh.boundary_tris, s.boundary_tris);
+  take(mesh.boundary_quads, s.boundary_quads);
+  s.boundary_tri_patch = mesh.boundary_tri_patch;
+  s.boundary_quad_patch = mesh.boundary_quad_patch;
+  return s;
+}
+
+// The per-patch forces of every rank's faces, summed (the maximum shear: the largest).
+void reduce_patch_forces(std::vector<PatchForce>& patches, MPI_Comm comm) {
+  std::vector<double> sums, maxima;
+  for (const auto& p : patches) {
+    sums.insert(sums.end(), {p.area, p.mean_shear * p.area});
+    for (int c = 0; c < 3; ++c) sums.insert(sums.end(), {p.pressure[c], p.viscous[c]});
+    maxima.push_back(p.max_shear);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, sums.data(), static_cast<int>(sums.size()), MPI_DOUBLE, MPI_SUM,
+                comm);
+  MPI_Allreduce(MPI_IN_PLACE, maxima.data(), static_cast<int>(maxima.size()), MPI_DOUBLE, MPI_MAX,
+                comm);
+  for (std::size_t k = 0; k < patches.size(); ++k) {
+    const double* v = sums.data() + 8 * k;
+    auto& p = patches[k];
+    p.area = v[0];
+    p.mean_shear = p.area > 0.0 ? v[1] / p.area : 0.0;
+    for (int c = 0; c < 3; ++c) {
+      p.pressure[c] = v[2 + 2 * c];
+      p.viscous[c] = v[3 + 2 * c];
+    }
+    p.max_shear = maxima[k];
+  }
+}
+
+// The wall shear of every boundary face of the whole mesh on `root`, from the faces each rank
+// owns (`face_index`: their places in the whole mesh's order).
+std::vector<Eigen::Vector3d> gather_face_shear(const std::vector<Eigen::Vector3d>& shear,
+                                               const std::vector<std::size_t>& face_index,
+                                               std::size_t faces, MPI_Comm comm, int root) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &ranks);
+  std::vector<double> mine;  // index, then the three components, per face
+  mine.reserve(4 * shear.size());
+  for (std::size_t f = 0; f < shear.size(); ++f)
+    mine.insert(mine.end(),
+                {static_cast<double>(face_index[f]), shear[f][0], shear[f][1], shear[f][2]});
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(counts.size(), 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, root, comm);
+  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<double> all(rank == root ? 4 * faces : 0);
+  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE,
+              root, comm);
+  std::vector<Eigen::Vector3d> whole(rank == root ? faces : 0, Eigen::Vector3d::Zero());
+  for (std::size_t k = 0; k + 3 < all.size(); k += 4)
+    whole[static_cast<std::size_t>(all[k])] = {all[k + 1], all[k + 2], all[k + 3]};
+  return whole;
+}
+
 }  // namespace
 
 AirflowResult run_airflow_job(const AirflowJob& job) {
@@ -118,7 +195,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     expression.emplace(job.inlet_expression);
     shape = [&](const Eigen::Vector3d& x, double distance) { return (*expression)(x, distance); };
   }
-  const DirichletConditions bc = airflow_conditions(mesh, job.profile, 1.0, nullptr, shape);
+  const DirichletConditions whole_bc = airflow_conditions(mesh, job.profile, 1.0, nullptr, shape);
 
   std::optional<SolutionState> resume;
   if (job.restart) {
@@ -136,16 +213,34 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   }
   // Every input is checked: only now does the job touch the output folder.
   ensure_writable_folder(job.output);
-  // Under MPI every rank runs the job on the whole mesh and shares the solves; the first
-  // writes the files.
-  int rank = 0;
+  // Under MPI every rank keeps its piece of the mesh and of the fields (parallel/partition.h)
+  // and shares the solves; the first gathers what it writes.
+  int rank = 0, ranks = 1;
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
   const bool writer = rank == 0;
   log_line(fmt::format("naris solve: {} ({} cells), Re {:.1f} on d_in {:.3f} mm, U_in {:.4f} m/s",
                        job.mesh.string(), r.cells, r.reynolds, r.d_in_mm, r.u_in));
 
   // Nondimensional geometry: lengths in units of d_in.
   for (auto& x : mesh.nodes) x /= r.d_in_mm;
+  // The pieces; the whole mesh goes (the first rank keeps its boundary for boundary.vtp).
+  const MeshCounts counts = mesh_counts(mesh);
+  const std::size_t boundary_faces = mesh.boundary_tris.size() + mesh.boundary_quads.size();
+  parallel::MeshPiece piece;
+  HybridMesh surface;
+  if (ranks == 1) {
+    piece.numbering = parallel::whole_numbering(mesh.nodes.size());
+    piece.mesh = std::move(mesh);
+  } else {
+    piece = parallel::mesh_piece(mesh, rank, ranks);
+    if (writer) surface = boundary_surface(mesh);
+  }
+  mesh = HybridMesh{};
+  const HybridMesh& local = piece.mesh;
+  const parallel::NodeNumbering& numbering = piece.numbering;
+  const DirichletConditions bc = local_conditions(whole_bc, numbering);
+  if (resume) resume->field = local_field(resume->field, numbering);
 
   // Reynolds-number continuation: each step warm-started from the last converged one; the
   // step grows after an easy step and is halved after a failed one.
@@ -165,9 +260,10 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     log_line(fmt::format("  restarting from Re {:.1f} ({})", reached, job.restart->string()));
   }
   const fs::path checkpoint = job.output / "checkpoint.h5";
+  // The state at `at` on the first rank, the last good field gathered from all.
   auto state_at = [&](double at) {
     SolutionState s;
-    s.field = last_good;
+    s.field = gather_field(last_good, numbering, PETSC_COMM_WORLD, 0);
     s.reynolds = at;
     s.target_reynolds = r.reynolds;
     s.u_in = r.u_in;
@@ -228,7 +324,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       }
     }
     try {
-      field = solve_navier_stokes(mesh, 1.0 / re, {}, bc, attempt, &report,
+      field = solve_navier_stokes(local, numbering, 1.0 / re, {}, bc, attempt, &report,
                                   predict         ? &predicted
                                   : reached > 0.0 ? &last_good
                                                   : nullptr);
@@ -258,7 +354,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       }
       last_good = field;
       reached = re;
-      if (writer) write_solution_h5(state_at(re), checkpoint);  // the last good step, on disk
+      const SolutionState state = state_at(re);          // collective
+      if (writer) write_solution_h5(state, checkpoint);  // the last good step, on disk
       if (cs.iterations < attempt.max_iterations / 3) step *= 1.5;
       re = std::min(r.reynolds, re + step);
       pseudo_retry = false;
@@ -291,22 +388,36 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   // SI results.
   const double u = r.u_in, pscale = job.density * u * u;
   r.flow_ml_s = u * r.inlet_area_mm2;  // m/s × mm² = 1e-6 m³/s = mL/s
-  r.outlet_flow_ml_s = patch_flux(mesh, last_good.velocity, outlet) * u * r.d_in_mm * r.d_in_mm;
-  r.pressure_drop_pa =
-      (patch_mean(mesh, last_good.pressure, inlet) - patch_mean(mesh, last_good.pressure, outlet)) *
-      pscale;
+  // Each rank's faces and nodes, summed over the ranks.
+  {
+    const PatchIntegral in = patch_integral(local, last_good.pressure, inlet),
+                        out = patch_integral(local, last_good.pressure, outlet);
+    double sums[5] = {patch_flux(local, last_good.velocity, outlet), in.integral, in.area,
+                      out.integral, out.area};
+    MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+    r.outlet_flow_ml_s = sums[0] * u * r.d_in_mm * r.d_in_mm;
+    r.pressure_drop_pa = (sums[1] / sums[2] - sums[3] / sums[4]) * pscale;
+  }
   r.resistance = r.pressure_drop_pa / r.flow_ml_s;
-  for (const auto& v : last_good.velocity) r.max_speed = std::max(r.max_speed, v.norm() * u);
+  for (NodeId k = 0; k < numbering.owned; ++k)
+    r.max_speed = std::max(r.max_speed, last_good.velocity[static_cast<std::size_t>(k)].norm() * u);
+  MPI_Allreduce(MPI_IN_PLACE, &r.max_speed, 1, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
 
   // Stresses on the boundary, while the geometry is still nondimensional.
-  const WallStress stress = wall_stress(mesh, last_good, reached);
+  WallStress stress = wall_stress(local, last_good, reached);
+  if (ranks > 1) {
+    reduce_patch_forces(stress.patches, PETSC_COMM_WORLD);
+    stress.shear =
+        gather_face_shear(stress.shear, piece.face_index, boundary_faces, PETSC_COMM_WORLD, 0);
+  }
   const double force_scale = pscale * d_in * d_in;
   for (const auto& p : stress.patches)
     r.patches.push_back({p.name, p.area * r.d_in_mm * r.d_in_mm, p.pressure * force_scale,
                          p.viscous * force_scale, p.mean_shear * pscale, p.max_shear * pscale});
 
   // Files, in millimetres again.
-  for (auto& x : mesh.nodes) x *= r.d_in_mm;
+  for (auto& x : piece.mesh.nodes) x *= r.d_in_mm;
+  for (auto& x : surface.nodes) x *= r.d_in_mm;
   PointFields fields;
   auto vector_field = [&](double scale) {
     PointField f{3, {}};
@@ -327,23 +438,19 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   // The volume: one file from a serial run; under MPI a .pvtu whose pieces the ranks write at
   // once, each its own cells. Files of the other form left by an earlier run are removed, so
   // the folder never offers two different answers.
-  int ranks = 1;
-  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
   const fs::path vtu = job.output / "solution.vtu", pvtu = job.output / "solution.pvtu";
   if (writer) remove_stale_volume_files(vtu, pvtu, ranks);
   if (ranks == 1) {
-    write_vtu(mesh, vtu, {}, fields);
+    write_vtu(local, vtu, {}, fields);
     r.written.push_back(vtu.string());
   } else {
-    const parallel::NodeRange range = parallel::owned_nodes(mesh.nodes.size(), rank, ranks);
     // A rank that cannot write its piece (disk full) must not leave the others waiting in the
     // reductions below: every rank learns that one failed.
     std::string failure;
     try {
       write_pvtu_piece(
-          mesh, pvtu, rank, ranks,
-          [&](std::span<const NodeId> cell) { return parallel::owns_cell(range, cell); }, {},
-          fields);
+          local, pvtu, rank, ranks,
+          [&](std::span<const NodeId> cell) { return numbering.owns_cell(cell); }, {}, fields);
     } catch (const Error& e) {
       failure = e.what();
     }
@@ -364,6 +471,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     r.peak_memory = largest;
     r.total_peak_memory = sum;
   }
+  const SolutionState final_state = state_at(reached);  // collective
   if (!writer) {
     r.seconds = total.seconds();
     return r;
@@ -378,11 +486,11 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     faces["wall_shear_stress"] = std::move(vec);
     faces["wall_shear_stress_magnitude"] = std::move(mag);
     const fs::path vtp = job.output / "boundary.vtp";
-    write_boundary_vtp(mesh, vtp, faces);
+    write_boundary_vtp(ranks > 1 ? surface : boundary_surface(local), vtp, faces);
     r.written.push_back(vtp.string());
   }
   const fs::path h5 = job.output / "solution.h5";
-  write_solution_h5(state_at(reached), h5, &mesh, job.mesh);
+  write_solution_h5(final_state, h5, &counts, job.mesh);
   r.written.push_back(h5.string());
   r.written.push_back(fs::path(h5).replace_extension(".xdmf").string());
 

@@ -19,8 +19,8 @@ namespace {
 
 using petsc::check;
 
-// For every node in [lo, hi), the sorted list of nodes sharing a cell with it (itself
-// included): the block sparsity of those rows.
+// For every node in [lo, hi) (local numbers), the sorted list of nodes sharing a cell with it
+// (itself included): the block sparsity of those rows.
 std::vector<std::vector<NodeId>> node_graph(const HybridMesh& mesh, NodeId lo, NodeId hi) {
   std::vector<std::vector<NodeId>> g(static_cast<std::size_t>(hi - lo));
   auto add = [&](const auto& cells) {
@@ -39,57 +39,42 @@ std::vector<std::vector<NodeId>> node_graph(const HybridMesh& mesh, NodeId lo, N
   return g;
 }
 
-// The system over the ranks of `comm`: rank r owns the nodes [lo_r, hi_r) and their four rows,
-// and assembles the cells it owns (parallel/partition.h). Every rank holds the mesh and the
-// whole current iterate, which the solve gathers after each step.
+// The system over the ranks of `comm`: each rank holds its piece of the mesh
+// (parallel/partition.h) in local node numbers, owns the rows of its nodes (four each), and
+// assembles the cells it owns; its iterate covers the piece (owned and halo nodes), refreshed
+// from the distributed solution after each step.
 class OseenSystem {
  public:
-  OseenSystem(const HybridMesh& mesh, MPI_Comm comm, const std::string& prefix, int backflow_patch,
-              double backflow_beta, MatType type)
-      : mesh_(mesh), backflow_patch_(backflow_patch), backflow_beta_(backflow_beta) {
+  OseenSystem(const HybridMesh& mesh, const parallel::NodeNumbering& numbering, MPI_Comm comm,
+              const std::string& prefix, int backflow_patch, double backflow_beta, MatType type)
+      : mesh_(mesh),
+        numbering_(numbering),
+        backflow_patch_(backflow_patch),
+        backflow_beta_(backflow_beta) {
     int rank = 0, size = 1;
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &size);
     rank_ = rank;
-    const auto n = static_cast<std::int64_t>(mesh.nodes.size());
-    owned_ = parallel::owned_nodes(mesh.nodes.size(), rank, size);
-    const NodeId lo = owned_.first, hi = owned_.end;
-    if (size > 1) {
+    if (size > 1 && numbering.global.empty())
+      fail("internal: {} ranks share a system without a mesh piece each", size);
+    const auto n = static_cast<std::int64_t>(numbering.global_nodes);
+    all_cells_ = numbering.global.empty();
+    if (!all_cells_) {
       owned_cells(mesh.tets, owned_tets_);
       owned_cells(mesh.pyramids, owned_pyramids_);
       owned_cells(mesh.hexes, owned_hexes_);
-      // The recovered gradient and lumped mass are needed at the owned nodes and at every node
-      // of an owned cell; each of those takes all the cells around it.
-      std::vector<char> needed(mesh.nodes.size(), 0);
-      std::fill(needed.begin() + lo, needed.begin() + hi, 1);
-      auto mark = [&](const auto& cells, const std::vector<std::size_t>& owned) {
-        for (std::size_t c : owned)
-          for (NodeId v : cells[c]) needed[static_cast<std::size_t>(v)] = 1;
-      };
-      mark(mesh.tets, owned_tets_);
-      mark(mesh.pyramids, owned_pyramids_);
-      mark(mesh.hexes, owned_hexes_);
-      auto touching = [&](const auto& cells, std::vector<std::size_t>& halo) {
-        for (std::size_t c = 0; c < cells.size(); ++c)
-          if (std::any_of(cells[c].begin(), cells[c].end(),
-                          [&](NodeId v) { return needed[static_cast<std::size_t>(v)] != 0; }))
-            halo.push_back(c);
-      };
-      touching(mesh.tets, halo_tets_);
-      touching(mesh.pyramids, halo_pyramids_);
-      touching(mesh.hexes, halo_hexes_);
     }
-    all_cells_ = size == 1;
-    const auto graph = node_graph(mesh, lo, hi);
-    const PetscInt local = hi - lo;
+    const NodeId owned = numbering.owned;
+    const auto graph = node_graph(mesh, 0, owned);
+    const PetscInt local = owned;
     std::vector<PetscInt> diagonal(static_cast<std::size_t>(local)),
         off_diagonal(static_cast<std::size_t>(local));
-    for (NodeId i = lo; i < hi; ++i) {
-      const auto& row = graph[static_cast<std::size_t>(i - lo)];
+    for (NodeId i = 0; i < owned; ++i) {
+      const auto& row = graph[static_cast<std::size_t>(i)];
       const auto inside =
-          std::count_if(row.begin(), row.end(), [&](NodeId j) { return owned_.contains(j); });
-      diagonal[static_cast<std::size_t>(i - lo)] = static_cast<PetscInt>(inside);
-      off_diagonal[static_cast<std::size_t>(i - lo)] =
+          std::count_if(row.begin(), row.end(), [&](NodeId j) { return numbering.owns(j); });
+      diagonal[static_cast<std::size_t>(i)] = static_cast<PetscInt>(inside);
+      off_diagonal[static_cast<std::size_t>(i)] =
           static_cast<PetscInt>(row.size()) - static_cast<PetscInt>(inside);
     }
     check(MatCreate(comm, matrix_.out()), "MatCreate");
@@ -113,34 +98,41 @@ class OseenSystem {
     check(VecDuplicate(rhs_, solution_.out()), "VecDuplicate");
     check(VecDuplicate(rhs_, residual_.out()), "VecDuplicate");
     check(VecDuplicate(rhs_, scratch_.out()), "VecDuplicate");
-    // The whole vector on every rank, for the iterate.
-    check(VecScatterCreateToAll(rhs_, gather_.out(), whole_.out()), "VecScatterCreateToAll");
+    // The iterate on the piece: the owned rows and the halo's, from whichever rank owns them.
+    const auto nodes = static_cast<PetscInt>(mesh.nodes.size());
+    std::vector<PetscInt> blocks(static_cast<std::size_t>(nodes));
+    for (NodeId k = 0; k < nodes; ++k) blocks[static_cast<std::size_t>(k)] = numbering.to_global(k);
+    petsc::IndexSet from;
+    check(ISCreateBlock(PETSC_COMM_SELF, 4, nodes, blocks.data(), PETSC_COPY_VALUES, from.out()),
+          "ISCreateBlock");
+    check(VecCreateSeq(PETSC_COMM_SELF, 4 * nodes, piece_.out()), "VecCreateSeq");
+    check(VecScatterCreate(rhs_, from, piece_, nullptr, gather_.out()), "VecScatterCreate");
   }
 
-  bool owns(NodeId node) const { return owned_.contains(node); }
+  bool owns(NodeId node) const { return numbering_.owns(node); }
+  PetscInt block(NodeId node) const { return numbering_.to_global(node); }
   int rank() const { return rank_; }
 
-  // v's values at every node, on every rank.
+  // v's values at every node of the piece.
   void gather(Vec v, FlowField& field) {
-    check(VecScatterBegin(gather_, v, whole_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
-    check(VecScatterEnd(gather_, v, whole_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+    check(VecScatterBegin(gather_, v, piece_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
+    check(VecScatterEnd(gather_, v, piece_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
     const PetscScalar* x = nullptr;
-    check(VecGetArrayRead(whole_, &x), "VecGetArrayRead");
+    check(VecGetArrayRead(piece_, &x), "VecGetArrayRead");
     for (std::size_t k = 0; k < field.pressure.size(); ++k) {
       field.velocity[k] = {x[4 * k], x[4 * k + 1], x[4 * k + 2]};
       field.pressure[k] = x[4 * k + 3];
     }
-    check(VecRestoreArrayRead(whole_, &x), "VecRestoreArrayRead");
+    check(VecRestoreArrayRead(piece_, &x), "VecRestoreArrayRead");
   }
 
   // The field into v's rows of this rank.
   void distribute(const FlowField& field, Vec v) const {
     PetscScalar* x = nullptr;
     check(VecGetArray(v, &x), "VecGetArray");
-    for (NodeId k = owned_.first; k < owned_.end; ++k) {
-      const auto i = static_cast<std::size_t>(k - owned_.first), g = static_cast<std::size_t>(k);
-      for (int c = 0; c < 3; ++c) x[4 * i + static_cast<std::size_t>(c)] = field.velocity[g][c];
-      x[4 * i + 3] = field.pressure[g];
+    for (std::size_t i = 0; i < static_cast<std::size_t>(numbering_.owned); ++i) {
+      for (int c = 0; c < 3; ++c) x[4 * i + static_cast<std::size_t>(c)] = field.velocity[i][c];
+      x[4 * i + 3] = field.pressure[i];
     }
     check(VecRestoreArray(v, &x), "VecRestoreArray");
   }
@@ -154,13 +146,13 @@ class OseenSystem {
   void recover_gradient(const std::vector<Eigen::Vector3d>& a) {
     gradient_.assign(mesh_.nodes.size(), Eigen::Matrix<double, 1, 9>::Zero());
     std::vector<double> mass(mesh_.nodes.size(), 0.0);
-    auto run = [&](const auto& all, const std::vector<std::size_t>& listed, auto element) {
+    // Every cell of the piece: the gradient is needed at the nodes of owned cells, and the
+    // piece holds all the cells around those.
+    auto run = [&](const auto& cells, auto element) {
       using E = decltype(element);
       constexpr int N = E::nodes;
       Eigen::Matrix<double, N, 3> X, A;
-      const std::size_t count = all_cells_ ? all.size() : listed.size();
-      for (std::size_t k = 0; k < count; ++k) {
-        const auto& cell = all[all_cells_ ? k : listed[k]];
+      for (const auto& cell : cells) {
         for (int i = 0; i < N; ++i) {
           X.row(i) = mesh_.nodes[static_cast<std::size_t>(cell[i])].transpose();
           A.row(i) = a[static_cast<std::size_t>(cell[i])].transpose();
@@ -179,9 +171,9 @@ class OseenSystem {
         }
       }
     };
-    run(mesh_.tets, halo_tets_, fem::Tet4{});
-    run(mesh_.pyramids, halo_pyramids_, fem::Pyr5{});
-    run(mesh_.hexes, halo_hexes_, fem::Hex8{});
+    run(mesh_.tets, fem::Tet4{});
+    run(mesh_.pyramids, fem::Pyr5{});
+    run(mesh_.hexes, fem::Hex8{});
     for (std::size_t n = 0; n < mass.size(); ++n)
       if (mass[n] > 0.0) gradient_[n] /= mass[n];
     lumped_mass_ = std::move(mass);
@@ -196,12 +188,11 @@ class OseenSystem {
     PetscScalar* d = nullptr;
     check(VecSet(scratch_, 0.0), "VecSet");
     check(VecGetArray(scratch_, &d), "VecGetArray");
-    for (NodeId k = owned_.first; k < owned_.end; ++k) {
-      const auto n = static_cast<std::size_t>(k), i = static_cast<std::size_t>(k - owned_.first);
-      const double m = lumped_mass_[n];
+    for (std::size_t i = 0; i < static_cast<std::size_t>(numbering_.owned); ++i) {
+      const double m = lumped_mass_[i];
       if (!(m > 0.0)) continue;
       const double h = std::cbrt(m);
-      const double rate = (advection[n].norm() + nu / h) / (cfl * h);
+      const double rate = (advection[i].norm() + nu / h) / (cfl * h);
       for (int c = 0; c < 3; ++c) d[4 * i + static_cast<std::size_t>(c)] = m * rate;
     }
     check(VecRestoreArray(scratch_, &d), "VecRestoreArray");
@@ -223,8 +214,8 @@ class OseenSystem {
     assemble_cells<fem::Pyr5>(mesh_.pyramids, owned_pyramids_, advection, pressure, nu, f,
                               linearization);
     assemble_cells<fem::Hex8>(mesh_.hexes, owned_hexes_, advection, pressure, nu, f, linearization);
-    // The outlet faces are few: the first rank takes them all.
-    if (backflow_patch_ >= 0 && rank_ == 0) assemble_backflow(advection, linearization);
+    // The piece holds the boundary faces this rank owns.
+    if (backflow_patch_ >= 0) assemble_backflow(advection, linearization);
     check(MatAssemblyBegin(matrix_, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
     check(MatAssemblyEnd(matrix_, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
     for (Vec v : {rhs_.get(), residual_.get()}) {
@@ -282,7 +273,7 @@ class OseenSystem {
       std::array<double, 16> r{};  // M u, the term's share of the residual (u = a here)
       std::array<PetscInt, 4> ids{};
       for (int i = 0; i < m; ++i) {
-        ids[static_cast<std::size_t>(i)] = v[static_cast<std::size_t>(i)];
+        ids[static_cast<std::size_t>(i)] = this->block(v[static_cast<std::size_t>(i)]);
         for (int j = 0; j < m; ++j)
           for (int c = 0; c < 3; ++c) {
             block[static_cast<std::size_t>((4 * i + c) * 4 * m + 4 * j + c)] = M(i, j);
@@ -307,7 +298,7 @@ class OseenSystem {
   template <class Cells>
   void owned_cells(const Cells& cells, std::vector<std::size_t>& owned) const {
     for (std::size_t c = 0; c < cells.size(); ++c)
-      if (parallel::owns_cell(owned_, cells[c])) owned.push_back(c);
+      if (numbering_.owns_cell(cells[c])) owned.push_back(c);
   }
 
   template <class E, class Cells, class Force>
@@ -332,7 +323,7 @@ class OseenSystem {
         a.row(i) = advection[n].transpose();
         grad.row(i) = gradient_[n];
         p[i] = pressure[n];
-        blocks[static_cast<std::size_t>(i)] = cell[static_cast<std::size_t>(i)];
+        blocks[static_cast<std::size_t>(i)] = block(cell[static_cast<std::size_t>(i)]);
       }
       oseen_element<E>(X, a, &grad, nu, force, sys, p, linearization);
       K = sys.K;
@@ -347,15 +338,14 @@ class OseenSystem {
   }
 
   const HybridMesh& mesh_;
+  const parallel::NodeNumbering& numbering_;
   int backflow_patch_ = -1;
   double backflow_beta_ = 0.0;
   petsc::Matrix matrix_;
   int rank_ = 0;
-  parallel::NodeRange owned_;  // the nodes whose rows this rank holds
-  bool all_cells_ = true;      // one rank: every cell, no lists
+  bool all_cells_ = true;  // the whole mesh on one rank: every cell, no lists
   std::vector<std::size_t> owned_tets_, owned_pyramids_, owned_hexes_;  // assembled here
-  std::vector<std::size_t> halo_tets_, halo_pyramids_, halo_hexes_;     // for the gradient
-  petsc::Vector rhs_, solution_, residual_, scratch_, whole_;
+  petsc::Vector rhs_, solution_, residual_, scratch_, piece_;
   petsc::Scatter gather_;
   std::vector<Eigen::Matrix<double, 1, 9>> gradient_;  // recovered ∇a per node
   std::vector<double> lumped_mass_;                    // ∫ N_i per node
@@ -363,9 +353,10 @@ class OseenSystem {
 
 }  // namespace
 
-FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce& force,
-                              const DirichletConditions& bc, const PicardOptions& options,
-                              PicardReport* report, const FlowField* initial) {
+FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumbering& numbering,
+                              double nu, const BodyForce& force, const DirichletConditions& bc,
+                              const PicardOptions& options, PicardReport* report,
+                              const FlowField* initial) {
   if (!(nu > 0.0) || !std::isfinite(nu)) fail("viscosity must be positive and finite (got {})", nu);
   if (bc.nodes.size() != bc.values.size())
     fail("Dirichlet conditions: {} nodes but {} values", bc.nodes.size(), bc.values.size());
@@ -380,7 +371,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
   using Scheme = PicardOptions::Scheme;
   const bool segregated = options.scheme == Scheme::segregated;
   // The segregated sweep takes the velocity and pressure blocks out: scalar (AIJ) storage.
-  OseenSystem system(mesh, comm, options.options_prefix, options.backflow_patch,
+  OseenSystem system(mesh, numbering, comm, options.options_prefix, options.backflow_patch,
                      options.backflow_beta, options.scheme == Scheme::coupled ? MATBAIJ : MATAIJ);
   std::optional<SegregatedStep> sweep;
   if (segregated)
@@ -393,11 +384,12 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
   for (std::size_t k = 0; k < bc.nodes.size(); ++k) {
     field.velocity[static_cast<std::size_t>(bc.nodes[k])] = bc.values[k];
     if (system.owns(bc.nodes[k]))
-      for (int c = 0; c < 3; ++c) rows.push_back(4 * bc.nodes[k] + c);
+      for (int c = 0; c < 3; ++c) rows.push_back(4 * system.block(bc.nodes[k]) + c);
   }
   if (bc.pressure_pin) {
     field.pressure[static_cast<std::size_t>(bc.pressure_pin->first)] = bc.pressure_pin->second;
-    if (system.owns(bc.pressure_pin->first)) rows.push_back(4 * bc.pressure_pin->first + 3);
+    if (system.owns(bc.pressure_pin->first))
+      rows.push_back(4 * system.block(bc.pressure_pin->first) + 3);
   }
 
   petsc::LinearSolver ksp;
@@ -630,6 +622,107 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
     stokes = false;
   }
   return field;
+}
+
+FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce& force,
+                              const DirichletConditions& bc, const PicardOptions& options,
+                              PicardReport* report, const FlowField* initial) {
+  const MPI_Comm comm =
+      options.communicator == MPI_COMM_NULL ? PETSC_COMM_WORLD : options.communicator;
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &ranks);
+  if (ranks == 1)
+    return solve_navier_stokes(mesh, parallel::whole_numbering(mesh.nodes.size()), nu, force, bc,
+                               options, report, initial);
+  const parallel::MeshPiece piece = parallel::mesh_piece(mesh, rank, ranks);
+  std::optional<FlowField> start;
+  if (initial) start = local_field(*initial, piece.numbering);
+  const FlowField local = solve_navier_stokes(piece.mesh, piece.numbering, nu, force,
+                                              local_conditions(bc, piece.numbering), options,
+                                              report, start ? &*start : nullptr);
+  return gather_field(local, piece.numbering, comm);
+}
+
+namespace {
+
+// The local number of a global node on the piece, or −1: the owned range directly, the halo
+// by bisection (it is sorted by global number).
+NodeId local_node(const parallel::NodeNumbering& numbering, NodeId global) {
+  if (numbering.global.empty()) return global;
+  if (numbering.range.contains(global)) return global - numbering.range.first;
+  const auto halo = numbering.global.begin() + numbering.owned;
+  const auto it = std::lower_bound(halo, numbering.global.end(), global);
+  return it != numbering.global.end() && *it == global
+             ? static_cast<NodeId>(it - numbering.global.begin())
+             : -1;
+}
+
+}  // namespace
+
+FlowField local_field(const FlowField& whole, const parallel::NodeNumbering& numbering) {
+  if (whole.pressure.size() != numbering.global_nodes)
+    fail("a field of {} nodes on a mesh of {}", whole.pressure.size(), numbering.global_nodes);
+  const std::size_t n = numbering.global.empty() ? numbering.global_nodes : numbering.global.size();
+  FlowField f{std::vector<Eigen::Vector3d>(n), std::vector<double>(n)};
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto g = static_cast<std::size_t>(numbering.to_global(static_cast<NodeId>(k)));
+    f.velocity[k] = whole.velocity[g];
+    f.pressure[k] = whole.pressure[g];
+  }
+  return f;
+}
+
+DirichletConditions local_conditions(const DirichletConditions& whole,
+                                     const parallel::NodeNumbering& numbering) {
+  DirichletConditions local;
+  for (std::size_t k = 0; k < whole.nodes.size(); ++k)
+    if (const NodeId l = local_node(numbering, whole.nodes[k]); l >= 0) {
+      local.nodes.push_back(l);
+      local.values.push_back(whole.values[k]);
+    }
+  if (whole.pressure_pin)
+    if (const NodeId l = local_node(numbering, whole.pressure_pin->first); l >= 0)
+      local.pressure_pin = {l, whole.pressure_pin->second};
+  return local;
+}
+
+FlowField gather_field(const FlowField& local, const parallel::NodeNumbering& numbering,
+                       MPI_Comm comm, int root) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &ranks);
+  // Four values per node, owned nodes in global order: the ranks' ranges tile the whole.
+  const auto owned = static_cast<std::size_t>(numbering.owned);
+  std::vector<double> mine(4 * owned);
+  for (std::size_t k = 0; k < owned; ++k) {
+    for (int c = 0; c < 3; ++c) mine[4 * k + static_cast<std::size_t>(c)] = local.velocity[k][c];
+    mine[4 * k + 3] = local.pressure[k];
+  }
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(counts.size());
+  for (int r = 0; r < ranks; ++r) {
+    const auto range = parallel::owned_nodes(numbering.global_nodes, r, ranks);
+    counts[static_cast<std::size_t>(r)] = 4 * (range.end - range.first);
+    offsets[static_cast<std::size_t>(r)] = 4 * range.first;
+  }
+  const bool receives = root < 0 || rank == root;
+  std::vector<double> all(receives ? 4 * numbering.global_nodes : 0);
+  const int count = static_cast<int>(mine.size());
+  if (root < 0)
+    MPI_Allgatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
+                   MPI_DOUBLE, comm);
+  else
+    MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
+                MPI_DOUBLE, root, comm);
+  FlowField whole;
+  if (!receives) return whole;
+  whole.velocity.resize(numbering.global_nodes);
+  whole.pressure.resize(numbering.global_nodes);
+  for (std::size_t k = 0; k < numbering.global_nodes; ++k) {
+    whole.velocity[k] = {all[4 * k], all[4 * k + 1], all[4 * k + 2]};
+    whole.pressure[k] = all[4 * k + 3];
+  }
+  return whole;
 }
 
 }  // namespace naris::ns

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "hybrid_mesh.h"
+#include "parallel/partition.h"
 
 namespace naris::ns {
 
@@ -64,8 +65,7 @@ struct PicardOptions {
   // fails, every later solve of this call rebuilds. The converged answer is
   // the same either way; only the linear iterations differ.
   bool reuse_preconditioner = true;
-  // The ranks that share the system (MPI_COMM_NULL: PETSC_COMM_WORLD); each needs the whole
-  // mesh and returns the whole field.
+  // The ranks that share the system (MPI_COMM_NULL: PETSC_COMM_WORLD).
   MPI_Comm communicator = MPI_COMM_NULL;
   bool log_iterations = false;  // a line per step (residual, relaxation, linear iterations)
   // Outflow stabilization on this patch (the outlet; −1: none) with coefficient β ∈ [0, 1].
@@ -83,8 +83,27 @@ struct PicardReport {
 
 // Solves with viscosity ν (1/Re in nondimensional form) and body force f (may be empty).
 // `initial` (optional) warm-starts; otherwise the first iterate is the Stokes solution.
+// Each rank of the communicator passes its piece of the mesh (parallel::mesh_piece; the whole
+// mesh with parallel::whole_numbering on one rank), the conditions and the initial field on
+// that piece, and gets the field on it back.
+FlowField solve_navier_stokes(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
+                              double nu, const BodyForce& force,
+                              const DirichletConditions& conditions, const PicardOptions& options,
+                              PicardReport* report = nullptr, const FlowField* initial = nullptr);
+
+// The same from the whole mesh on every rank: the ranks cut it into pieces, solve, and each
+// gets the whole field back. For tests and small problems.
 FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce& force,
                               const DirichletConditions& conditions, const PicardOptions& options,
                               PicardReport* report = nullptr, const FlowField* initial = nullptr);
+
+// A whole field's values on a piece, and conditions on the whole mesh as the piece's.
+FlowField local_field(const FlowField& whole, const parallel::NodeNumbering& numbering);
+DirichletConditions local_conditions(const DirichletConditions& whole,
+                                     const parallel::NodeNumbering& numbering);
+// The whole field from the owned nodes of every rank's piece: on every rank (`root` < 0) or on
+// rank `root` only (the others get an empty field). Collective over `comm`.
+FlowField gather_field(const FlowField& local, const parallel::NodeNumbering& numbering,
+                       MPI_Comm comm, int root = -1);
 
 }  // namespace naris::ns

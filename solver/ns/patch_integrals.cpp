@@ -13,7 +13,7 @@ double patch_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u,
   return flux;
 }
 
-double patch_mean(const HybridMesh& mesh, const std::vector<double>& values, int patch) {
+PatchIntegral patch_integral(const HybridMesh& mesh, const std::vector<double>& values, int patch) {
   double sum = 0.0, area = 0.0;
   for_each_boundary_face(mesh, [&](std::span<const NodeId> v, int id) {
     if (id != patch) return;
@@ -23,7 +23,7 @@ double patch_mean(const HybridMesh& mesh, const std::vector<double>& values, int
     sum += a * mean / static_cast<double>(v.size());
     area += a;
   });
-  return area > 0.0 ? sum / area : 0.0;
+  return {sum, area};
 }
 
 }  // namespace naris::ns

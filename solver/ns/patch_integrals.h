@@ -9,7 +9,10 @@ namespace naris::ns {
 
 // ∫ u·n dA over the faces of `patch` (n outward).
 double patch_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u, int patch);
-// Area-weighted mean of a nodal scalar over the faces of `patch`.
-double patch_mean(const HybridMesh& mesh, const std::vector<double>& values, int patch);
+// ∫ v dA and the area of the faces of `patch` (summed over ranks, these give the mean).
+struct PatchIntegral {
+  double integral = 0.0, area = 0.0;
+};
+PatchIntegral patch_integral(const HybridMesh& mesh, const std::vector<double>& values, int patch);
 
 }  // namespace naris::ns

@@ -42,11 +42,11 @@ void write_fields(hid_t file, const char* velocity, const char* pressure, const 
   write_table(file, pressure, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p.data(), p.size(), 1, path);
 }
 
-void write_xdmf(const HybridMesh& mesh, const fs::path& h5, const fs::path& mesh_file) {
+void write_xdmf(const MeshCounts& mesh, const fs::path& h5, const fs::path& mesh_file) {
   const fs::path folder = fs::absolute(h5).parent_path();
   const std::string m = fs::relative(fs::absolute(mesh_file), folder).string();
   const std::string s = h5.filename().string();
-  const std::size_t n = mesh.nodes.size();
+  const std::size_t n = mesh.nodes;
   std::ostringstream x;
   x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
     << " <Grid Name=\"solution\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
@@ -72,14 +72,18 @@ void write_xdmf(const HybridMesh& mesh, const fs::path& h5, const fs::path& mesh
         << "</DataItem></Attribute>\n";
     x << "  </Grid>\n";
   };
-  grid("tetrahedra", "Tetrahedron", mesh.tets.size(), 4, "/cells/tet");
-  grid("pyramids", "Pyramid", mesh.pyramids.size(), 5, "/cells/pyramid");
-  grid("hexahedra", "Hexahedron", mesh.hexes.size(), 8, "/cells/hex");
+  grid("tetrahedra", "Tetrahedron", mesh.tets, 4, "/cells/tet");
+  grid("pyramids", "Pyramid", mesh.pyramids, 5, "/cells/pyramid");
+  grid("hexahedra", "Hexahedron", mesh.hexes, 8, "/cells/hex");
   x << " </Grid>\n </Domain>\n</Xdmf>\n";
   write_text_file(fs::path(h5).replace_extension(".xdmf"), x.str());
 }
 
 }  // namespace
+
+MeshCounts mesh_counts(const HybridMesh& mesh) {
+  return {mesh.nodes.size(), mesh.tets.size(), mesh.pyramids.size(), mesh.hexes.size()};
+}
 
 std::uint64_t mesh_fingerprint(const HybridMesh& mesh) {
   std::uint64_t h = 1469598103934665603ull;
@@ -94,7 +98,7 @@ std::uint64_t mesh_fingerprint(const HybridMesh& mesh) {
   return h;
 }
 
-void write_solution_h5(const SolutionState& s, const fs::path& path, const HybridMesh* mesh,
+void write_solution_h5(const SolutionState& s, const fs::path& path, const MeshCounts* mesh,
                        const fs::path& mesh_file) {
   SilenceHdf5 quiet;
   {

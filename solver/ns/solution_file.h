@@ -25,13 +25,19 @@ struct SolutionState {
   std::uint64_t mesh_fingerprint = 0;
 };
 
+// The sizes the XDMF sidecar names: the rank that writes it need not hold the mesh.
+struct MeshCounts {
+  std::size_t nodes = 0, tets = 0, pyramids = 0, hexes = 0;
+};
+MeshCounts mesh_counts(const HybridMesh& mesh);
+
 // FNV-1a over the node coordinates and the cells: equal meshes, equal fingerprints.
 std::uint64_t mesh_fingerprint(const HybridMesh& mesh);
 
-// Writes atomically. With `mesh_file` (the mesh.h5 the solution belongs to), also writes the SI
-// fields and the XDMF sidecar beside `path`.
+// Writes atomically. With `mesh` (the sizes of mesh_file, the mesh.h5 the solution belongs
+// to), also writes the SI fields and the XDMF sidecar beside `path`.
 void write_solution_h5(const SolutionState& state, const std::filesystem::path& path,
-                       const HybridMesh* mesh = nullptr,
+                       const MeshCounts* mesh = nullptr,
                        const std::filesystem::path& mesh_file = {});
 
 // Throws naris::Error for a missing, unreadable or foreign file.

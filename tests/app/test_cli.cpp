@@ -13,6 +13,8 @@
 #include <sstream>
 #include <vector>
 
+#include "ns/solution_file.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -507,8 +509,22 @@ TEST_F(Cli, SolveOnTwoRanksMatchesOneRank) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("2 MPI ranks"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("naris solve: mesh.h5"), r.err.rfind("naris solve: mesh.h5")) << r.err;
-  for (const char* key : {"pressure_drop_pa", "max_speed_m_s", "outlet_flow_ml_s"})
+  // The first patch's forces and shear are summed over the ranks' faces.
+  for (const char* key : {"pressure_drop_pa", "max_speed_m_s", "outlet_flow_ml_s", "area_mm2",
+                          "mean_wall_shear_pa", "max_wall_shear_pa"})
     EXPECT_NEAR(summary(two, key), summary(one, key), 2e-6 * std::abs(summary(one, key))) << key;
+  // The fields each rank solved on its piece, gathered into one file.
+  const naris::ns::SolutionState a = naris::ns::read_solution_h5(one / "solution.h5"),
+                                 b = naris::ns::read_solution_h5(two / "solution.h5");
+  ASSERT_EQ(a.field.pressure.size(), b.field.pressure.size());
+  double speed = 0.0, du = 0.0;
+  for (std::size_t k = 0; k < a.field.velocity.size(); ++k) {
+    speed = std::max(speed, a.field.velocity[k].norm());
+    du = std::max(du, (a.field.velocity[k] - b.field.velocity[k]).norm());
+  }
+  EXPECT_LT(du, 1e-6 * speed);
+  // The wall shear of every face, gathered from the ranks' pieces.
+  EXPECT_EQ(fs::file_size(two / "boundary.vtp"), fs::file_size(one / "boundary.vtp"));
   // The volume as ParaView's parallel format, a piece per rank, instead of one file.
   for (const char* f : {"solution.pvtu", "solution_0.vtu", "solution_1.vtu"})
     EXPECT_TRUE(fs::exists(two / f)) << f;

@@ -1,5 +1,6 @@
 // Run with two MPI ranks (ctest does): the solve shared by the ranks of PETSC_COMM_WORLD —
-// rows split, cells assembled where their first node lives, block-Jacobi preconditioning —
+// each on its piece of the mesh, cells assembled where their smallest node lives, the halo of
+// the iterate refreshed after each step, block-Jacobi preconditioning —
 // reaches the same discrete solution as the solve each rank does alone on PETSC_COMM_SELF, to
 // the nonlinear tolerance; the Ethier–Steinman flow on an MVE ball has every cell type.
 #include <gtest/gtest.h>
@@ -52,7 +53,7 @@ TEST(Mpi, SeveralRanksReachTheSerialSolution) {
         dp, pscale);
   EXPECT_LT(du, 1e-7 * scale);
   EXPECT_LT(dp, 1e-6 * pscale);
-  // Every rank holds the same gathered field.
+  // Every rank holds the same field, gathered from the pieces.
   double mine = 0.0;
   for (const auto& v : parallel.velocity) mine += v.sum();
   double lowest = 0.0, highest = 0.0;
