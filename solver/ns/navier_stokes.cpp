@@ -648,22 +648,6 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce
   return gather_field(local, piece.numbering, comm);
 }
 
-namespace {
-
-// The local number of a global node on the piece, or −1: the owned range directly, the halo
-// by bisection (it is sorted by global number).
-NodeId local_node(const parallel::NodeNumbering& numbering, NodeId global) {
-  if (numbering.global.empty()) return global;
-  if (numbering.range.contains(global)) return global - numbering.range.first;
-  const auto halo = numbering.global.begin() + numbering.owned;
-  const auto it = std::lower_bound(halo, numbering.global.end(), global);
-  return it != numbering.global.end() && *it == global
-             ? static_cast<NodeId>(it - numbering.global.begin())
-             : -1;
-}
-
-}  // namespace
-
 FlowField local_field(const FlowField& whole, const parallel::NodeNumbering& numbering) {
   if (whole.pressure.size() != numbering.global_nodes)
     fail("a field of {} nodes on a mesh of {}", whole.pressure.size(), numbering.global_nodes);
@@ -681,12 +665,12 @@ DirichletConditions local_conditions(const DirichletConditions& whole,
                                      const parallel::NodeNumbering& numbering) {
   DirichletConditions local;
   for (std::size_t k = 0; k < whole.nodes.size(); ++k)
-    if (const NodeId l = local_node(numbering, whole.nodes[k]); l >= 0) {
+    if (const NodeId l = numbering.to_local(whole.nodes[k]); l >= 0) {
       local.nodes.push_back(l);
       local.values.push_back(whole.values[k]);
     }
   if (whole.pressure_pin)
-    if (const NodeId l = local_node(numbering, whole.pressure_pin->first); l >= 0)
+    if (const NodeId l = numbering.to_local(whole.pressure_pin->first); l >= 0)
       local.pressure_pin = {l, whole.pressure_pin->second};
   return local;
 }

@@ -1,5 +1,7 @@
 #include "parallel/partition.h"
 
+#include <algorithm>
+
 namespace naris::parallel {
 
 NodeNumbering whole_numbering(std::size_t nodes) {
@@ -8,6 +10,15 @@ NodeNumbering whole_numbering(std::size_t nodes) {
   n.range = {0, static_cast<NodeId>(nodes)};
   n.global_nodes = nodes;
   return n;
+}
+
+NodeId NodeNumbering::to_local(NodeId global_node) const {
+  if (global.empty()) return global_node;
+  if (range.contains(global_node)) return global_node - range.first;
+  // The halo is sorted by global number: bisection.
+  const auto halo = global.begin() + owned;
+  const auto it = std::lower_bound(halo, global.end(), global_node);
+  return it != global.end() && *it == global_node ? static_cast<NodeId>(it - global.begin()) : -1;
 }
 
 MeshPiece mesh_piece(const HybridMesh& whole, int rank, int ranks) {

@@ -38,6 +38,8 @@ struct NodeNumbering {
   NodeId to_global(NodeId local) const {
     return global.empty() ? local : global[static_cast<std::size_t>(local)];
   }
+  // The inverse: the local number of a global node, or −1 where the piece does not hold it.
+  NodeId to_local(NodeId global_node) const;
   bool owns(NodeId local) const { return local < owned; }
   // A cell (or face) in local numbers belongs to this rank when its smallest global node is
   // owned (the rule above, so that every cell has exactly one owner).

@@ -48,7 +48,15 @@ TEST(Partition, PiecesShareTheMeshWithoutGapsOrOverlaps) {
         const auto g = static_cast<std::size_t>(num.global[l]);
         EXPECT_EQ(piece.mesh.nodes[l], whole.nodes[g]);
         EXPECT_EQ(num.owns(static_cast<NodeId>(l)), num.range.contains(num.global[l]));
+        EXPECT_EQ(num.to_local(num.global[l]), static_cast<NodeId>(l));
       }
+      // A node the piece does not hold has no local number.
+      std::vector<char> held(whole.nodes.size(), 0);
+      for (NodeId g : num.global) held[static_cast<std::size_t>(g)] = 1;
+      for (std::size_t g = 0; g < held.size(); ++g)
+        if (!held[g]) {
+          EXPECT_EQ(num.to_local(static_cast<NodeId>(g)), -1) << g;
+        }
       std::map<NodeId, std::set<CellKey>> kept;
       add_cells(piece.mesh.tets, num.global, kept, nullptr);
       add_cells(piece.mesh.pyramids, num.global, kept, nullptr);
