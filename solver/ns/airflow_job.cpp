@@ -289,13 +289,16 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   };
   PicardOptions picard = job.picard;
   picard.backflow_patch = outlet;
-  // With pseudo-time available, each Re is tried first without it, on a short budget: Newton
-  // from the last solution follows the steady branch even where that branch is unstable, which
-  // time-like steps cannot (on the neonatal airway near Re 600 they wander at residuals of
-  // 1e-1 to 1e-2). Where Newton fails — near Re 190 there, where the branch ends — the same Re
-  // is retried with pseudo-time before the increment is halved.
+  // With pseudo-time available, each Re is tried with both methods before the increment is
+  // halved: Newton alone (on a short budget) and with pseudo-time, first the one that took the
+  // last step. Newton from the last solution follows the steady branch even where that branch
+  // is unstable, which time-like steps cannot (on the neonatal airway near Re 600 they wander
+  // at residuals of 1e-1 to 1e-2). Where Newton fails — near Re 190 there, where the branch
+  // ends — pseudo-time carries the flow across, and Newton keeps failing above: from Re 50 to
+  // 300 its tries at 225 and 300 cost 200 of 1130 s before pseudo-time converged.
   const bool pseudo_available = job.picard.pseudo_cfl > 0.0;
-  bool pseudo_retry = false;
+  bool pseudo_first = false;  // the last converged step needed pseudo-time
+  bool retry = false;         // the second try at this Re, with the other method
   for (int s = 0; s < job.max_steps && reached < r.reynolds; ++s) {
     ContinuationStep cs;
     cs.reynolds = re;
@@ -303,7 +306,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     PicardReport report;
     PicardOptions attempt = picard;
     if (re < r.reynolds) attempt.tolerance = std::max(picard.tolerance, job.step_tolerance);
-    if (pseudo_available && !pseudo_retry) {
+    const bool pseudo = pseudo_available && (pseudo_first != retry);
+    if (pseudo_available && !pseudo) {
       attempt.pseudo_cfl = 0.0;
       attempt.max_iterations = std::min(picard.max_iterations, 25);
       // Where Newton fails on the neonatal airway it crawls (3.9e-2 → 3.3e-2 in five steps at
@@ -313,8 +317,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     // The first try at each Re starts from the secant predictor through the last two converged
     // fields, u(Re) ≈ u₁ + (u₁ − u₀)(Re − Re₁)/(Re₁ − Re₀) (the boundary data are the same, so
     // it keeps them): on the phantom it takes a Newton step or two off every continuation step.
-    // The retry with pseudo-time starts from the last converged field itself.
-    const bool predict = earlier_re > 0.0 && !pseudo_retry;
+    // A retry, and pseudo-time, start from the last converged field itself.
+    const bool predict = earlier_re > 0.0 && !retry && !pseudo;
     if (predict) {
       const double t = (1.0 / re - 1.0 / reached) / (1.0 / reached - 1.0 / earlier_re);
       predicted = last_good;
@@ -342,13 +346,12 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     r.steps.push_back(cs);
     log_line(fmt::format("  Re {:8.1f}: {} after {} nonlinear steps{}, residual {:.2e}, {:.1f} s",
                          re, cs.converged ? "converged" : "FAILED", cs.iterations,
-                         attempt.pseudo_cfl > 0.0 ? " with pseudo-time" : "", cs.residual,
-                         cs.seconds));
+                         pseudo ? " with pseudo-time" : "", cs.residual, cs.seconds));
     if (cs.converged) {
       // A step that needed pseudo-time may have crossed to another branch (the neonatal
       // airway's jet near Re 190): no secant through the two branches.
       earlier_re = 0.0;
-      if (reached > 0.0 && !(attempt.pseudo_cfl > 0.0)) {
+      if (reached > 0.0 && !pseudo) {
         earlier = std::move(last_good);
         earlier_re = reached;
       }
@@ -358,11 +361,12 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       if (writer) write_solution_h5(state, checkpoint);  // the last good step, on disk
       if (cs.iterations < attempt.max_iterations / 3) step *= 1.5;
       re = std::min(r.reynolds, re + step);
-      pseudo_retry = false;
-    } else if (pseudo_available && !pseudo_retry) {
-      pseudo_retry = true;  // the same Re again, with pseudo-time
+      pseudo_first = pseudo;
+      retry = false;
+    } else if (pseudo_available && !retry) {
+      retry = true;  // the same Re again, with the other method
     } else {
-      pseudo_retry = false;
+      retry = false;
       if (reached == 0.0) {
         step = re *= 0.5;  // the very first step: start lower
       } else {
