@@ -317,8 +317,9 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     // The first try at each Re starts from the secant predictor through the last two converged
     // fields, u(Re) ≈ u₁ + (u₁ − u₀)(Re − Re₁)/(Re₁ − Re₀) (the boundary data are the same, so
     // it keeps them): on the phantom it takes a Newton step or two off every continuation step.
-    // A retry, and pseudo-time, start from the last converged field itself.
-    const bool predict = earlier_re > 0.0 && !retry && !pseudo;
+    // A retry starts from the last converged field itself, as does every step after one that
+    // needed pseudo-time (no secant then: `earlier_re` is 0).
+    const bool predict = earlier_re > 0.0 && !retry;
     if (predict) {
       const double t = (1.0 / re - 1.0 / reached) / (1.0 / reached - 1.0 / earlier_re);
       predicted = last_good;
