@@ -80,7 +80,12 @@ void add_solve_command(CLI::App& app) {
   cmd->add_flag("!--no-newton", job.picard.newton,
                 "Picard iteration only (linear convergence; stalls at high Re)");
   cmd->add_option("--linear-tolerance", job.picard.linear_tolerance,
-                  "each linear solve's residual reduction")
+                  "each linear solve's residual reduction, at the tightest")
+      ->check(CLI::Range(1e-14, 0.5))
+      ->capture_default_str();
+  cmd->add_option("--linear-tolerance-max", job.picard.loosest_linear_tolerance,
+                  "the loosest reduction, where the nonlinear residual falls slowly (Eisenstat–"
+                  "Walker; equal to --linear-tolerance: fixed)")
       ->check(CLI::Range(1e-14, 0.5))
       ->capture_default_str();
   cmd->add_option("--tolerance", job.picard.tolerance,

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "ns/forcing_term.h"
 #include "ns/oseen_element.h"
 #include "ns/preconditioner_reuse.h"
 #include "ns/segregated_step.h"
@@ -398,8 +399,9 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
   // GMRES on ILU(1) of the 4×4-block matrix in reverse Cuthill–McKee order: on the 89 k-cell
   // phantom at Re 300, 56 iterations where ILU(0) in mesh order needs 231, 3× faster per step
   // (ILU(2) halves the iterations again but not the time). Each solve is inexact: it stops
-  // when the residual of the correction equation has fallen by `linear_tolerance` — the outer
-  // iteration measures the true residual and corrects what is left.
+  // when the residual of the correction equation has fallen by the forcing term
+  // (forcing_term.h, at least `linear_tolerance`) — the outer iteration measures the true
+  // residual and corrects what is left.
   // `-ns_ksp_type preonly -ns_pc_type lu` gives a direct solve.
   check(KSPSetType(ksp, KSPGMRES), "KSPSetType");
   check(KSPGMRESSetRestart(ksp, 200), "KSPGMRESSetRestart");
@@ -436,8 +438,11 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
     }
   }
   check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
-  PetscInt max_linear_iterations = 0;  // as set, by default or from the command line
-  check(KSPGetTolerances(ksp, nullptr, nullptr, nullptr, &max_linear_iterations),
+  // As set, by default or from the command line: the tightest relative tolerance and the
+  // iteration limit.
+  PetscReal tightest_linear_tolerance = 0.0;
+  PetscInt max_linear_iterations = 0;
+  check(KSPGetTolerances(ksp, &tightest_linear_tolerance, nullptr, nullptr, &max_linear_iterations),
         "KSPGetTolerances");
 
   // Any preconditioner of the coupled system may be kept; the segregated sweeps set theirs up
@@ -468,7 +473,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
     }
   };
   const std::vector<double> zeros(rows.size(), 0.0);
-  double cfl = INFINITY;
+  double cfl = INFINITY, eta = tightest_linear_tolerance;  // eta: the linear solve's tolerance
   int solves = 0, decreasing = 0, picard_run = 0;
   bool newton_step = false;  // the kind of the last solve
   for (int it = 0; solves <= options.max_iterations + 1 && it < 4 * options.max_iterations + 8;
@@ -492,15 +497,16 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
       check(VecAssemblyEnd(system.residual()), "VecAssemblyEnd");
       check(VecNorm(system.residual(), NORM_2, &norm), "VecNorm");
       // Switched evolution relaxation: the Courant number follows the residual's fall, so the
-      // steps turn into Newton's (or Picard's) as the iteration converges — but grows at most
-      // 4× a step: on the neonatal airway at Re 400 a residual that dipped for one step raised
-      // the CFL 10× and the next step blew the residual up 20×. It never drops below a tenth
-      // of the first.
+      // steps turn into Newton's (or Picard's) as the iteration converges — as the square of
+      // the ratio (on the neonatal airway from Re 150 to 300 with a fixed linear tolerance, 36
+      // steps where the ratio itself took 42) but at most 4× a step: at Re 400 there a
+      // residual that dipped for one step raised the CFL 10× and the next step blew the
+      // residual up 20×. It never drops below a tenth of the first.
       if (options.pseudo_cfl > 0.0 && norm > 0.0) {
-        cfl = std::isfinite(previous_norm)
-                  ? std::clamp(cfl * previous_norm / norm, 0.1 * options.pseudo_cfl,
-                               std::min(4.0 * cfl, 1e12))
-                  : options.pseudo_cfl;
+        const double fall = previous_norm / norm;
+        cfl = std::isfinite(previous_norm) ? std::clamp(cfl * fall * fall, 0.1 * options.pseudo_cfl,
+                                                        std::min(4.0 * cfl, 1e12))
+                                           : options.pseudo_cfl;
         if (cfl < 1e8) system.add_pseudo_time(field.velocity, nu, cfl);
       }
     }
@@ -535,6 +541,12 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
         omega = std::min(options.relaxation, 2.0 * omega);
         decreasing = 0;
       }
+      if (!segregated) {
+        eta = forcing_term(norm, previous_norm, eta, tightest_linear_tolerance,
+                           options.loosest_linear_tolerance);
+        check(KSPSetTolerances(ksp, eta, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT),
+              "KSPSetTolerances");
+      }
       previous_norm = norm;
       if (solves > options.max_iterations) break;
       const auto& history = r.residuals;
@@ -565,6 +577,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
                         : newton ? LinearProblem::newton
                                  : LinearProblem::picard;
       PetscInt its = 0, abandoned = 0;  // abandoned: those of a kept preconditioner's try
+      const double decades = -std::log10(stokes ? tightest_linear_tolerance : eta);
       bool rebuilt = false;
       // A solve that fails or runs over its budget with a kept preconditioner is retried with a
       // fresh one; a failure with a fresh one is the linear solver's.
@@ -572,10 +585,10 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
         check(KSPSetOperators(ksp, system.matrix(), system.matrix()), "KSPSetOperators");
         check(KSPSetReusePreconditioner(ksp, rebuild ? PETSC_FALSE : PETSC_TRUE),
               "KSPSetReusePreconditioner");
-        check(KSPSetTolerances(
-                  ksp, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT,
-                  rebuild ? max_linear_iterations
-                          : std::min<PetscInt>(max_linear_iterations, reuse.iteration_budget())),
+        check(KSPSetTolerances(ksp, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT,
+                               rebuild ? max_linear_iterations
+                                       : std::min<PetscInt>(max_linear_iterations,
+                                                            reuse.iteration_budget(decades))),
               "KSPSetTolerances");
         Stopwatch setup;
         check(KSPSetUp(ksp), "KSPSetUp");  // the factorization, when it is rebuilt
@@ -589,11 +602,11 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
         double seconds[2] = {setup_seconds, solve.seconds()};
         MPI_Allreduce(MPI_IN_PLACE, seconds, 2, MPI_DOUBLE, MPI_MAX, comm);
         if (rebuild) {
-          reuse.built(kind, seconds[0], seconds[1], static_cast<int>(its));
+          reuse.built(kind, seconds[0], seconds[1], static_cast<int>(its), decades);
           ++r.preconditioner_builds;
           rebuilt = true;
         } else {
-          reuse.kept(seconds[1], static_cast<int>(its));
+          reuse.kept(seconds[1], static_cast<int>(its), decades);
           abandoned = its;
         }
         if (reason >= 0 || rebuild) break;

@@ -44,8 +44,11 @@ struct PicardOptions {
   // Each linear solve (for the correction, from a zero guess) stops when its residual has
   // fallen by this factor: the nonlinear residual times this is what the step leaves unsolved.
   double linear_tolerance = 1e-3;
+  // … at the tightest: the tolerance of each step follows how fast the nonlinear residual falls
+  // (forcing_term.h), between linear_tolerance and this (equal: a fixed tolerance).
+  double loosest_linear_tolerance = 0.1;
   // Pseudo-transient continuation: the first step's Courant number (0: off), raised as the
-  // residual falls (CFL · R₀/R).
+  // residual falls (as (R_{k−1}/R_k)², at most 4× a step).
   double pseudo_cfl = 0.0;
   // Give up (not converged) when the residual has not halved over this many steps (0: never):
   // a stalled attempt is better retried another way than run to max_iterations.

@@ -1,6 +1,7 @@
 #pragma once
 // When the nonlinear solver keeps the linear solver's preconditioner for the next step.
 #include <algorithm>
+#include <cmath>
 
 namespace naris::ns {
 
@@ -11,23 +12,27 @@ namespace naris::ns {
 // It is rebuilt for a new kind of linearization, and once the iterations the last solve added
 // over the first one after the build cost more time than a build; after a kept solve has run
 // out of its budget, it is no longer kept at all (for the rest of that nonlinear solve).
+// Solves to different tolerances (forcing_term.h) are compared by their iterations per decade
+// of residual reduction.
 enum class LinearProblem { stokes, picard, newton };
 
 class PreconditionerReuse {
  public:
   explicit PreconditionerReuse(bool enabled) : enabled_(enabled) {}
   bool keeps(LinearProblem kind) const { return enabled_ && built_ && kind == kind_ && !stale_; }
-  void built(LinearProblem kind, double setup_seconds, double solve_seconds, int iterations) {
+  // `decades`: the reduction the solve was asked for, log10(1/tolerance).
+  void built(LinearProblem kind, double setup_seconds, double solve_seconds, int iterations,
+             double decades) {
     built_ = true;
     stale_ = false;
     kind_ = kind;
     setup_seconds_ = setup_seconds;
-    fresh_iterations_ = iterations;
+    fresh_rate_ = iterations / std::max(decades, 0.1);
     seconds_per_iteration_ = solve_seconds / std::max(iterations, 1);
   }
-  void kept(double solve_seconds, int iterations) {
+  void kept(double solve_seconds, int iterations, double decades) {
     if (iterations > 0) seconds_per_iteration_ = solve_seconds / iterations;
-    stale_ = (iterations - fresh_iterations_) * seconds_per_iteration_ > setup_seconds_;
+    stale_ = (iterations - fresh_iterations(decades)) * seconds_per_iteration_ > setup_seconds_;
   }
   // A kept solve ran out of its budget (or failed): the matrices change too fast for keeping
   // to pay (under pseudo-time on the neonatal airway near Re 470 every other kept solve ran out,
@@ -37,16 +42,19 @@ class PreconditionerReuse {
   // with a fresh one: the iterations of a fresh solve plus a build's worth, so a kept
   // factorization that went bad costs at most twice what rebuilding at once would have (on the
   // neonatal airway a kept ILU once took 276 iterations where a fresh one took 91).
-  int iteration_budget() const {
+  int iteration_budget(double decades) const {
     const double extra = setup_seconds_ / std::max(seconds_per_iteration_, 1e-12);
-    return fresh_iterations_ + static_cast<int>(std::min(extra, 1e6)) + 1;
+    return static_cast<int>(std::ceil(fresh_iterations(decades)) + std::min(extra, 1e6)) + 1;
   }
 
  private:
   bool enabled_ = false, built_ = false, stale_ = false;
   LinearProblem kind_ = LinearProblem::stokes;
+  // What a fresh preconditioner would take for this reduction.
+  double fresh_iterations(double decades) const { return fresh_rate_ * std::max(decades, 0.1); }
+
   double setup_seconds_ = 0.0, seconds_per_iteration_ = 0.0;
-  int fresh_iterations_ = 0;
+  double fresh_rate_ = 0.0;  // iterations per decade with a fresh preconditioner
 };
 
 }  // namespace naris::ns

@@ -15,6 +15,7 @@
 #include "fem/reference_element.h"
 #include "manufactured.h"
 #include "meshes.h"
+#include "ns/forcing_term.h"
 #include "ns/navier_stokes.h"
 #include "ns/oseen_element.h"
 #include "ns/preconditioner_reuse.h"
@@ -239,29 +240,58 @@ TEST(NavierStokes, KeptPreconditionerReachesTheSameSolution) {
 }
 
 // The rule itself, on made-up timings: a build costs 2 s, a fresh solve 100 iterations of
-// 10 ms. A kept preconditioner stays while the iterations it adds cost less than a build.
+// 10 ms for 3 decades (a tolerance of 1e-3). A kept preconditioner stays while the iterations
+// it adds cost less than a build.
 TEST(PreconditionerReuse, KeepsWhileTheAddedIterationsCostLessThanABuild) {
   PreconditionerReuse reuse(true);
   EXPECT_FALSE(reuse.keeps(LinearProblem::stokes));  // nothing built yet
-  reuse.built(LinearProblem::newton, 2.0, 1.0, 100);
+  reuse.built(LinearProblem::newton, 2.0, 1.0, 100, 3.0);
   EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
   EXPECT_FALSE(reuse.keeps(LinearProblem::picard));  // another kind of matrix
-  EXPECT_EQ(reuse.iteration_budget(), 100 + 200 + 1);
-  reuse.kept(1.5, 150);  // 50 more, 0.5 s < 2 s
+  EXPECT_EQ(reuse.iteration_budget(3.0), 100 + 200 + 1);
+  reuse.kept(1.5, 150, 3.0);  // 50 more, 0.5 s < 2 s
   EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
-  reuse.kept(3.0, 300);  // 200 more, exactly a build: still kept
+  reuse.kept(3.0, 300, 3.0);  // 200 more, exactly a build: still kept
   EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
-  reuse.kept(3.1, 310);  // 210 more, 2.1 s > 2 s
+  reuse.kept(3.1, 310, 3.0);  // 210 more, 2.1 s > 2 s
   EXPECT_FALSE(reuse.keeps(LinearProblem::newton));
-  reuse.built(LinearProblem::newton, 2.0, 1.0, 100);
+  reuse.built(LinearProblem::newton, 2.0, 1.0, 100, 3.0);
   EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
   reuse.abandoned();  // a kept solve ran out of its budget: no more keeping
-  reuse.built(LinearProblem::newton, 2.0, 1.0, 100);
+  reuse.built(LinearProblem::newton, 2.0, 1.0, 100, 3.0);
   EXPECT_FALSE(reuse.keeps(LinearProblem::newton));
 
   PreconditionerReuse off(false);
-  off.built(LinearProblem::newton, 2.0, 1.0, 100);
+  off.built(LinearProblem::newton, 2.0, 1.0, 100, 3.0);
   EXPECT_FALSE(off.keeps(LinearProblem::newton));
+}
+
+// Solves to other tolerances are judged by iterations per decade: a fresh build that took 20
+// iterations for one decade (a tolerance of 0.1) makes 60 the fresh count for three.
+TEST(PreconditionerReuse, ComparesSolvesToOtherTolerancesPerDecade) {
+  PreconditionerReuse reuse(true);
+  reuse.built(LinearProblem::newton, 2.0, 0.2, 20, 1.0);
+  EXPECT_EQ(reuse.iteration_budget(3.0), 60 + 200 + 1);
+  reuse.kept(2.5, 250, 3.0);  // 190 more than 60: 1.9 s < 2 s
+  EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
+  reuse.kept(0.8, 80, 0.5);  // 70 more than 10: 0.7 s < 2 s
+  EXPECT_TRUE(reuse.keeps(LinearProblem::newton));
+  reuse.kept(2.3, 230, 1.0);  // 210 more than 20: 2.1 s > 2 s
+  EXPECT_FALSE(reuse.keeps(LinearProblem::newton));
+}
+
+// Eisenstat–Walker's choice 2: γ·ratio², the safeguard after a loose step, the bounds.
+TEST(ForcingTerm, FollowsTheSquareOfTheResidualRatioWithinItsBounds) {
+  EXPECT_DOUBLE_EQ(forcing_term(1.0, INFINITY, 0.0, 1e-3, 0.1), 0.1);  // no ratio yet
+  EXPECT_DOUBLE_EQ(forcing_term(0.2, 1.0, 1e-3, 1e-3, 0.1), 0.9 * 0.04);
+  EXPECT_DOUBLE_EQ(forcing_term(0.9, 1.0, 1e-3, 1e-3, 0.1), 0.1);    // slow fall: loosest
+  EXPECT_DOUBLE_EQ(forcing_term(1e-3, 1.0, 1e-3, 1e-3, 0.1), 1e-3);  // fast fall: tightest
+  // After η = 0.5 a sudden drop keeps γ η² = 0.225 (then bounded to 0.3).
+  EXPECT_DOUBLE_EQ(forcing_term(1e-3, 1.0, 0.5, 1e-3, 0.3), 0.9 * 0.25);
+  // No safeguard below γ η² = 0.1.
+  EXPECT_DOUBLE_EQ(forcing_term(1e-2, 1.0, 0.3, 1e-5, 0.3), 0.9 * 1e-4);
+  // Bounds equal: a fixed tolerance.
+  EXPECT_DOUBLE_EQ(forcing_term(0.5, 1.0, 1e-3, 1e-3, 1e-3), 1e-3);
 }
 
 // The Newton matrix is the derivative of the element residual: against central differences of
