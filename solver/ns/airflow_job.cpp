@@ -295,9 +295,12 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   // is unstable, which time-like steps cannot (on the neonatal airway near Re 600 they wander
   // at residuals of 1e-1 to 1e-2). Where Newton fails — near Re 190 there, where the branch
   // ends — pseudo-time carries the flow across, and Newton keeps failing above: from Re 50 to
-  // 300 its tries at 225 and 300 cost 200 of 1130 s before pseudo-time converged.
+  // 300 its tries at 225 and 300 cost 200 of 1130 s before pseudo-time converged. From rest
+  // pseudo-time goes first: the Stokes field is far from the first step's solution, where
+  // damped Newton steps crawl (on the neonatal airway at Re 50 Newton alone gave up after 10
+  // steps and 112 s; pseudo-time took 14 steps and 119 s). A restart starts with Newton.
   const bool pseudo_available = job.picard.pseudo_cfl > 0.0;
-  bool pseudo_first = false;  // the last converged step needed pseudo-time
+  bool pseudo_first = !resume;  // from rest, or the last converged step needed pseudo-time
   bool retry = false;         // the second try at this Re, with the other method
   for (int s = 0; s < job.max_steps && reached < r.reynolds; ++s) {
     ContinuationStep cs;
