@@ -577,7 +577,8 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
                         : newton ? LinearProblem::newton
                                  : LinearProblem::picard;
       PetscInt its = 0, abandoned = 0;  // abandoned: those of a kept preconditioner's try
-      const double decades = -std::log10(stokes ? tightest_linear_tolerance : eta);
+      // The reduction asked for (the first, Stokes, solve's is the tightest).
+      const double decades = -std::log10(eta);
       bool rebuilt = false;
       // A solve that fails or runs over its budget with a kept preconditioner is retried with a
       // fresh one; a failure with a fresh one is the linear solver's.
