@@ -541,12 +541,8 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
         omega = std::min(options.relaxation, 2.0 * omega);
         decreasing = 0;
       }
-      if (!segregated) {
-        eta = forcing_term(norm, previous_norm, eta, tightest_linear_tolerance,
-                           options.loosest_linear_tolerance);
-        check(KSPSetTolerances(ksp, eta, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT),
-              "KSPSetTolerances");
-      }
+      eta = forcing_term(norm, previous_norm, eta, tightest_linear_tolerance,
+                         options.loosest_linear_tolerance);
       previous_norm = norm;
       if (solves > options.max_iterations) break;
       const auto& history = r.residuals;
@@ -586,7 +582,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
         check(KSPSetOperators(ksp, system.matrix(), system.matrix()), "KSPSetOperators");
         check(KSPSetReusePreconditioner(ksp, rebuild ? PETSC_FALSE : PETSC_TRUE),
               "KSPSetReusePreconditioner");
-        check(KSPSetTolerances(ksp, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT,
+        check(KSPSetTolerances(ksp, eta, PETSC_DEFAULT, PETSC_DEFAULT,
                                rebuild ? max_linear_iterations
                                        : std::min<PetscInt>(max_linear_iterations,
                                                             reuse.iteration_budget(decades))),

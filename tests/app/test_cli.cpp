@@ -583,7 +583,12 @@ TEST_F(Cli, SolveBadInput) {
   // until it falls below 1e-3 of the target, then one error line naming the checkpoint, which
   // still holds the last converged Re; the residual history of the failed steps is written.
   const fs::path good = dir_ / "in" / "good";
-  ASSERT_EQ(naris("solve " + cut.string() + " --re 8 -o " + good.string()).status, 0);
+  const CliRun from_rest = naris("solve " + cut.string() + " --re 8 -o " + good.string());
+  ASSERT_EQ(from_rest.status, 0) << from_rest.err;
+  // From rest, pseudo-time goes first.
+  EXPECT_NE(from_rest.err.find("8.0: converged after"), std::string::npos) << from_rest.err;
+  EXPECT_EQ(from_rest.err.find("FAILED"), std::string::npos) << from_rest.err;
+  EXPECT_NE(from_rest.err.find("with pseudo-time"), std::string::npos) << from_rest.err;
   auto bytes = [](const fs::path& f) {
     std::ifstream file(f, std::ios::binary);
     return std::string((std::istreambuf_iterator<char>(file)), {});
@@ -600,8 +605,8 @@ TEST_F(Cli, SolveBadInput) {
   EXPECT_NE(error.find("stalled at Re 8.0"), std::string::npos) << error;
   EXPECT_NE(error.find("holds the last converged step"), std::string::npos) << error;
   // Re 10 fails (the first increment after a restart is a quarter of the Re reached), then the
-  // halved increments: 9, 8.5, each with Newton and again with pseudo-time (no step has needed
-  // pseudo-time yet, so Newton goes first); the next increment, 0.25, is below 1e-3 × 400.
+  // halved increments: 9, 8.5, each with Newton and again with pseudo-time (a restart starts
+  // with Newton); the next increment, 0.25, is below 1e-3 × 400.
   std::vector<std::string> failures;
   std::istringstream lines(r.err);
   for (std::string line; std::getline(lines, line);)
