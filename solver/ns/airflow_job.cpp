@@ -240,7 +240,11 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   const HybridMesh& local = piece.mesh;
   const parallel::NodeNumbering& numbering = piece.numbering;
   const DirichletConditions bc = local_conditions(whole_bc, numbering);
-  if (resume) resume->field = local_field(resume->field, numbering);
+  if (resume) {
+    resume->field = local_field(resume->field, numbering);
+    if (resume->continuation.earlier_reynolds > 0.0)
+      resume->continuation.earlier = local_field(resume->continuation.earlier, numbering);
+  }
 
   // Reynolds-number continuation: each step warm-started from the last converged one; the
   // step grows after an easy step and is halved after a failed one.
@@ -250,14 +254,28 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   double earlier_re = 0.0;
   double re = std::min(job.start_reynolds, r.reynolds), step = re;
   double reached = 0.0;
+  // The method the last converged step needed goes first (pseudo-time from rest).
+  bool pseudo_first = true;
   if (resume) {
     last_good = resume->field;
     reached = resume->reynolds;
-    // The step that led there is not known: a quarter of the way so far, grown if easy (a
-    // doubling of Re in one step is too much for the constricted jets of real anatomy).
-    step = std::max(0.25 * reached, 1.0);
+    ContinuationState& c = resume->continuation;
+    if (c.next_step > 0.0) {
+      // Where the interrupted run stood: the restart takes the path it would have taken.
+      step = c.next_step;
+      pseudo_first = c.pseudo_time;
+      earlier_re = c.earlier_reynolds;
+      earlier = std::move(c.earlier);
+    } else {
+      // A file without the continuation (solution.h5): a quarter of the way so far, grown if
+      // easy (a doubling of Re in one step is too much for the constricted jets of real
+      // anatomy), Newton first.
+      step = std::max(0.25 * reached, 1.0);
+      pseudo_first = false;
+    }
     re = std::min(r.reynolds, reached + step);
-    log_line(fmt::format("  restarting from Re {:.1f} ({})", reached, job.restart->string()));
+    log_line(fmt::format("  restarting from Re {:.1f} ({}), next Re {:.1f}", reached,
+                         job.restart->string(), re));
   }
   const fs::path checkpoint = job.output / "checkpoint.h5";
   // The state at `at` on the first rank, the last good field gathered from all.
@@ -298,10 +316,9 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   // 300 its tries at 225 and 300 cost 200 of 1130 s before pseudo-time converged. From rest
   // pseudo-time goes first: the Stokes field is far from the first step's solution, where
   // damped Newton steps crawl (on the neonatal airway at Re 50 Newton alone gave up after 10
-  // steps and 112 s; pseudo-time took 14 steps and 119 s). A restart starts with Newton.
+  // steps and 112 s; pseudo-time took 14 steps and 119 s).
   const bool pseudo_available = job.picard.pseudo_cfl > 0.0;
-  bool pseudo_first = !resume;  // from rest, or the last converged step needed pseudo-time
-  bool retry = false;         // the second try at this Re, with the other method
+  bool retry = false;  // the second try at this Re, with the other method
   for (int s = 0; s < job.max_steps && reached < r.reynolds; ++s) {
     ContinuationStep cs;
     cs.reynolds = re;
@@ -361,12 +378,18 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       }
       last_good = field;
       reached = re;
-      const SolutionState state = state_at(re);          // collective
-      if (writer) write_solution_h5(state, checkpoint);  // the last good step, on disk
       if (cs.iterations < attempt.max_iterations / 3) step *= 1.5;
       re = std::min(r.reynolds, re + step);
       pseudo_first = pseudo;
       retry = false;
+      // The last good step on disk, with what comes next.
+      SolutionState state = state_at(reached);  // collective
+      state.continuation.next_step = step;
+      state.continuation.pseudo_time = pseudo;
+      state.continuation.earlier_reynolds = earlier_re;
+      if (earlier_re > 0.0)
+        state.continuation.earlier = gather_field(earlier, numbering, PETSC_COMM_WORLD, 0);
+      if (writer) write_solution_h5(state, checkpoint);
     } else if (pseudo_available && !retry) {
       retry = true;  // the same Re again, with the other method
     } else {

@@ -42,6 +42,19 @@ void write_fields(hid_t file, const char* velocity, const char* pressure, const 
   write_table(file, pressure, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p.data(), p.size(), 1, path);
 }
 
+FlowField read_fields(hid_t file, const char* velocity, const char* pressure,
+                      const fs::path& path) {
+  FlowField f;
+  read_table(file, velocity, H5T_NATIVE_DOUBLE, 3, f.velocity, path);
+  read_table(file, pressure, H5T_NATIVE_DOUBLE, 1, f.pressure, path);
+  if (f.velocity.size() != f.pressure.size())
+    fail("{}: {} and {} sizes differ", path.string(), velocity, pressure);
+  for (std::size_t n = 0; n < f.pressure.size(); ++n)
+    if (!std::isfinite(f.pressure[n]) || !f.velocity[n].allFinite())
+      fail("{}: a non-finite value at node {} of {}", path.string(), n, velocity);
+  return f;
+}
+
 void write_xdmf(const MeshCounts& mesh, const fs::path& h5, const fs::path& mesh_file) {
   const fs::path folder = fs::absolute(h5).parent_path();
   const std::string m = fs::relative(fs::absolute(mesh_file), folder).string();
@@ -118,6 +131,15 @@ void write_solution_h5(const SolutionState& s, const fs::path& path, const MeshC
     if (mesh)
       write_fields(file.get(), "velocity", "pressure", s.field, s.u_in, s.density * s.u_in * s.u_in,
                    path);
+    const ContinuationState& c = s.continuation;
+    if (c.next_step > 0.0) {
+      attribute(file.get(), "next_step", c.next_step, path);
+      attribute(file.get(), "pseudo_time", c.pseudo_time ? 1.0 : 0.0, path);
+      attribute(file.get(), "earlier_reynolds", c.earlier_reynolds, path);
+      if (c.earlier_reynolds > 0.0)
+        write_fields(file.get(), "earlier_velocity_nondimensional",
+                     "earlier_pressure_nondimensional", c.earlier, 1.0, 1.0, path);
+    }
     check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), path, "flush");
     file.reset();
     out.commit();
@@ -137,16 +159,23 @@ SolutionState read_solution_h5(const fs::path& path) {
   s.d_in_mm = number_attribute(file.get(), "d_in_mm", path);
   s.density = number_attribute(file.get(), "density", path);
   s.viscosity = number_attribute(file.get(), "viscosity", path);
-  std::vector<Eigen::Vector3d> u;
-  std::vector<double> p;
-  read_table(file.get(), "velocity_nondimensional", H5T_NATIVE_DOUBLE, 3, u, path);
-  read_table(file.get(), "pressure_nondimensional", H5T_NATIVE_DOUBLE, 1, p, path);
-  if (u.size() != p.size()) fail("{}: velocity and pressure sizes differ", path.string());
-  for (std::size_t n = 0; n < p.size(); ++n)
-    if (!std::isfinite(p[n]) || !u[n].allFinite())
-      fail("{}: a non-finite value at node {}", path.string(), n);
-  s.field.velocity = std::move(u);
-  s.field.pressure = std::move(p);
+  s.field = read_fields(file.get(), "velocity_nondimensional", "pressure_nondimensional", path);
+  if (H5Aexists(file.get(), "next_step") > 0) {
+    ContinuationState& c = s.continuation;
+    c.next_step = number_attribute(file.get(), "next_step", path);
+    c.pseudo_time = number_attribute(file.get(), "pseudo_time", path) != 0.0;
+    c.earlier_reynolds = number_attribute(file.get(), "earlier_reynolds", path);
+    if (!(c.next_step > 0.0) || !(c.earlier_reynolds >= 0.0) || c.earlier_reynolds >= s.reynolds)
+      fail("{}: an inconsistent continuation state (next step {}, earlier Re {} below Re {})",
+           path.string(), c.next_step, c.earlier_reynolds, s.reynolds);
+    if (c.earlier_reynolds > 0.0) {
+      c.earlier = read_fields(file.get(), "earlier_velocity_nondimensional",
+                              "earlier_pressure_nondimensional", path);
+      if (c.earlier.pressure.size() != s.field.pressure.size())
+        fail("{}: the earlier step has {} nodes, the solution {}", path.string(),
+             c.earlier.pressure.size(), s.field.pressure.size());
+    }
+  }
   return s;
 }
 

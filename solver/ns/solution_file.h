@@ -9,6 +9,15 @@
 //      d_in_mm, density, viscosity, mesh_fingerprint (hex), nodes
 //   /velocity_nondimensional [nodes, 3], /pressure_nondimensional [nodes]
 //   /velocity [nodes, 3] (m/s), /pressure [nodes] (Pa)             (solution.h5 only)
+//
+// A checkpoint also holds where the continuation stood, so that a restart takes the path the
+// uninterrupted run would have taken (checkpoint.h5 only; a file without them restarts with a
+// quarter of the Re reached as the increment, Newton first):
+//
+//   /  attributes next_step (the increment of Re to try next), pseudo_time (1: the step
+//      converged with pseudo-time, which the next one tries first), earlier_reynolds (the
+//      converged step before, 0: none)
+//   /earlier_velocity_nondimensional, /earlier_pressure_nondimensional  (earlier_reynolds > 0)
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -18,11 +27,21 @@
 
 namespace naris::ns {
 
+// Where the continuation stood after a converged step: what it does next. The earlier step
+// feeds the secant predictor of the next one.
+struct ContinuationState {
+  double next_step = 0.0;         // 0: not known (a solution file, or an older checkpoint)
+  bool pseudo_time = false;       // the step converged with pseudo-time
+  double earlier_reynolds = 0.0;  // 0: no earlier step for the predictor
+  FlowField earlier;              // nondimensional, at earlier_reynolds
+};
+
 struct SolutionState {
   FlowField field;  // nondimensional
   double reynolds = 0.0, target_reynolds = 0.0;
   double u_in = 0.0, d_in_mm = 0.0, density = 0.0, viscosity = 0.0;
   std::uint64_t mesh_fingerprint = 0;
+  ContinuationState continuation;  // written when next_step > 0
 };
 
 // The sizes the XDMF sidecar names: the rank that writes it need not hold the mesh.

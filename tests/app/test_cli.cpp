@@ -492,6 +492,60 @@ TEST_F(Cli, SolvesTheFlowThroughACutBall) {
   EXPECT_NE(text.find("\"inlet_profile\": \"expression 3 + 0*x*r\""), std::string::npos) << text;
 }
 
+// A run stopped after two continuation steps and resumed from its checkpoint takes the steps
+// the uninterrupted run took: the same Re, method and residuals (the checkpoint keeps the
+// next increment, the method and the earlier step of the secant predictor) — with pseudo-time
+// (the default, every step after the first from rest) and with Newton alone (the predictor).
+TEST_F(Cli, RestartTakesTheUninterruptedPath) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const fs::path mesh = dir_ / "out" / "mesh.h5";
+  ASSERT_EQ(naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string()).status,
+            0);
+  // residuals.csv rows without the step number: Re, converged, iteration, residual.
+  auto rows = [](const fs::path& folder) {
+    std::ifstream file(folder / "residuals.csv");
+    std::vector<std::string> out;
+    std::string line;
+    std::getline(file, line);
+    while (std::getline(file, line)) out.push_back(line.substr(line.find(',') + 1));
+    return out;
+  };
+  for (const std::string options : {"", " --pseudo-cfl 0"}) {
+    SCOPED_TRACE(options);
+    const std::string solve = "solve " + mesh.string() + " --re 20 --re-start 4" + options;
+    const fs::path whole = dir_ / "out" / "whole", stopped = dir_ / "out" / "stopped",
+                   resumed = dir_ / "out" / "resumed";
+    CliRun r = naris(solve + " -o " + whole.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    r = naris(solve + " --max-steps 2 -o " + stopped.string());
+    ASSERT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("in 2 steps"), std::string::npos) << r.err;
+    // Newton's second step has the first for its predictor.
+    const naris::ns::ContinuationState c =
+        naris::ns::read_solution_h5(stopped / "checkpoint.h5").continuation;
+    EXPECT_GT(c.next_step, 0.0);
+    EXPECT_EQ(c.pseudo_time, options.empty());
+    EXPECT_EQ(c.earlier_reynolds > 0.0, !options.empty()) << c.earlier_reynolds;
+    r = naris(solve + " --restart " + (stopped / "checkpoint.h5").string() + " -o " +
+              resumed.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto all = rows(whole), first = rows(stopped), rest = rows(resumed);
+    ASSERT_FALSE(first.empty());
+    ASSERT_FALSE(rest.empty());
+    ASSERT_EQ(first.size() + rest.size(), all.size());
+    EXPECT_TRUE(std::equal(first.begin(), first.end(), all.begin()));
+    // The Re of the steps after the restart, and their residual histories to the printed
+    // digits.
+    EXPECT_TRUE(std::equal(rest.begin(), rest.end(), all.begin() + static_cast<long>(first.size())))
+        << rest.front() << " against " << all[first.size()];
+    EXPECT_NEAR(summary(resumed, "pressure_drop_pa"), summary(whole, "pressure_drop_pa"),
+                1e-6 * summary(whole, "pressure_drop_pa"));
+    fs::remove_all(whole);
+    fs::remove_all(stopped);
+    fs::remove_all(resumed);
+  }
+}
+
 // The same binary under mpiexec: two ranks share the solves, one writes all but the volume,
 // which each rank writes a piece of; the answer is the serial one to the six digits of
 // summary.json.
@@ -579,9 +633,9 @@ TEST_F(Cli, SolveBadInput) {
       naris("solve " + cut.string() + " --restart " + (other / "checkpoint.h5").string() + o),
       "another mesh");
   // A step that cannot converge (one nonlinear iteration allowed, to the final tolerance
-  // at every step — from Re 8, one step gets Re 10 to 1e-5): the increment is halved
-  // until it falls below 1e-3 of the target, then one error line naming the checkpoint, which
-  // still holds the last converged Re; the residual history of the failed steps is written.
+  // 1e-8 at every step, which one iteration from the last Re does not reach): the increment is
+  // halved until it falls below 1e-3 of the target, then one error line naming the checkpoint,
+  // which still holds the last converged Re; the residual history of the failed steps is written.
   const fs::path good = dir_ / "in" / "good";
   const CliRun from_rest = naris("solve " + cut.string() + " --re 8 -o " + good.string());
   ASSERT_EQ(from_rest.status, 0) << from_rest.err;
@@ -594,6 +648,14 @@ TEST_F(Cli, SolveBadInput) {
     return std::string((std::istreambuf_iterator<char>(file)), {});
   };
   const std::string checkpoint = bytes(good / "checkpoint.h5");
+  // A checkpoint whose continuation contradicts itself: its earlier step above its own Re.
+  naris::ns::SolutionState odd = naris::ns::read_solution_h5(good / "checkpoint.h5");
+  odd.continuation.earlier_reynolds = odd.reynolds + 1.0;
+  odd.continuation.earlier = odd.field;
+  naris::ns::write_solution_h5(odd, dir_ / "in" / "odd.h5");
+  expect_clean_failure(
+      naris("solve " + cut.string() + " --restart " + (dir_ / "in" / "odd.h5").string() + o),
+      "inconsistent continuation state");
   const CliRun r = naris("solve " + cut.string() +
                          " --re 400 --max-iterations 1 --step-tolerance 1e-8 --restart " +
                          (good / "checkpoint.h5").string() + " -o " + good.string());
@@ -604,24 +666,31 @@ TEST_F(Cli, SolveBadInput) {
   EXPECT_EQ(std::count(error.begin(), error.end(), '\n'), 1) << error;
   EXPECT_NE(error.find("stalled at Re 8.0"), std::string::npos) << error;
   EXPECT_NE(error.find("holds the last converged step"), std::string::npos) << error;
-  // Re 10 fails (the first increment after a restart is a quarter of the Re reached), then the
-  // halved increments: 9, 8.5, each with Newton and again with pseudo-time (a restart starts
-  // with Newton); the next increment, 0.25, is below 1e-3 × 400.
+  // The restart takes the increment the checkpoint stored, so the first Re tried is 8 + d (the
+  // uninterrupted run's next step); it fails, then the halved increments 8 + d/2, 8 + d/4, … — each
+  // with pseudo-time first (the from-rest step needed it) and again with Newton — until the
+  // next would be below 1e-3 × 400.
+  std::smatch next;
+  ASSERT_TRUE(std::regex_search(r.err, next, std::regex("next Re ([0-9.]+)"))) << r.err;
+  std::vector<double> tried;
+  for (double d = std::stod(next[1]) - 8.0; d >= 0.4; d *= 0.5) tried.push_back(8.0 + d);
+  ASSERT_GE(tried.size(), 3u) << r.err;
   std::vector<std::string> failures;
   std::istringstream lines(r.err);
   for (std::string line; std::getline(lines, line);)
     if (line.find("FAILED") != std::string::npos) failures.push_back(line);
-  ASSERT_EQ(failures.size(), 6u) << r.err;
+  ASSERT_EQ(failures.size(), 2 * tried.size()) << r.err;
   for (std::size_t k = 0; k < failures.size(); ++k) {
-    EXPECT_NE(failures[k].find(k < 2   ? " 10.0: "
-                               : k < 4 ? " 9.0: "
-                                       : " 8.5: "),
-              std::string::npos)
+    std::smatch re;
+    ASSERT_TRUE(std::regex_search(failures[k], re, std::regex("Re +([0-9.]+): FAILED")))
         << failures[k];
-    EXPECT_EQ(failures[k].find("with pseudo-time") != std::string::npos, k % 2 == 1) << failures[k];
+    EXPECT_NEAR(std::stod(re[1]), tried[k / 2], 0.051) << failures[k];
+    EXPECT_EQ(failures[k].find("with pseudo-time") != std::string::npos, k % 2 == 0) << failures[k];
   }
   EXPECT_EQ(bytes(good / "checkpoint.h5"), checkpoint);
-  EXPECT_NE(bytes(good / "residuals.csv").find("\n0,10,0,0,"), std::string::npos);
+  std::ostringstream first;
+  first << "\n0," << tried[0] << ",0,0,";
+  EXPECT_NE(bytes(good / "residuals.csv").find(first.str()), std::string::npos);
 }
 
 }  // namespace
