@@ -25,10 +25,11 @@
 //   + Σ_K δτ_M ((u·∇)w + ∇q, r) + Σ_K δτ_C (∇·u, ∇·w)
 //
 // with r = (u·∇)u + ∇p − f the strong momentum residual and δτ the change of the τ's with u
-// (in the advective regime of the nasal airway they matter as much as the rest). Only the
-// reconstructed viscous term stays lagged (it carries a factor ν). Picard keeps only K(u):
-// linear convergence that stalls as Re grows; the derivative converges quadratically near
-// the solution.
+// (in the advective regime of the nasal airway they matter as much as the rest). The
+// derivative of the reconstructed viscous term reaches beyond the cell (the recovered gradient
+// at a node depends on all cells around it): reconstruction_derivative.h applies it beside the
+// assembled matrix. Picard keeps only K(u): linear convergence that stalls as Re grows; the
+// derivative converges quadratically near the solution.
 //
 // Degrees of freedom are interleaved per node: (u, v, w, p) of node 0, then node 1, …
 #include <Eigen/Dense>
@@ -68,6 +69,11 @@ Eigen::Matrix3d reference_metric() {
   } else {
     return Eigen::Matrix3d::Identity();
   }
+}
+
+// τ_M at a point with advection a, element metric G and viscosity ν.
+inline double momentum_tau(const Eigen::Vector3d& a, const Eigen::Matrix3d& metric, double nu) {
+  return std::sqrt(3.0 / (a.dot(metric * a) + nu * nu * metric.squaredNorm()));
 }
 
 // The quadrature degree for each cell type: 2 is exact for the affine tet's terms; the pyramid
@@ -127,7 +133,7 @@ void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
     // small τ of its thin direction.
     const Eigen::Matrix3d metric =
         m.inverse_jacobian.transpose() * reference_metric<E>() * m.inverse_jacobian;
-    const double tau_m = std::sqrt(3.0 / (aq.dot(metric * aq) + nu * nu * metric.squaredNorm()));
+    const double tau_m = momentum_tau(aq, metric, nu);
     const double tau_c = 3.0 / (tau_m * metric.trace());
     const Eigen::Matrix<double, N, 1> adv = G * aq;  // (a·∇)N_i
     const Eigen::Matrix<double, N, N> diffusion = G * G.transpose();

@@ -1,0 +1,146 @@
+#include "ns/reconstruction_derivative.h"
+
+#include <algorithm>
+#include <array>
+#include <utility>
+
+#include "ns/oseen_element.h"
+
+namespace naris::ns {
+
+ReconstructionDerivative::ReconstructionDerivative(const HybridMesh& piece, OwnedCells owned)
+    : mesh_(piece), owned_(std::move(owned)) {
+  const std::size_t n = piece.nodes.size();
+  // Two passes over the cells: the count of (repeated) neighbours per node, then the lists,
+  // sorted and made unique in place.
+  std::vector<std::size_t> count(n + 1, 0);
+  auto tally = [&](const auto& cells) {
+    for (const auto& c : cells)
+      for (NodeId a : c) count[static_cast<std::size_t>(a)] += c.size();
+  };
+  tally(piece.tets);
+  tally(piece.pyramids);
+  tally(piece.hexes);
+  std::vector<std::size_t> fill(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) fill[i + 1] = fill[i] + count[i];
+  std::vector<NodeId> all(fill[n]);
+  std::vector<std::size_t> at(fill.begin(), fill.end() - 1);
+  auto place = [&](const auto& cells) {
+    for (const auto& c : cells)
+      for (NodeId a : c)
+        for (NodeId b : c) all[at[static_cast<std::size_t>(a)]++] = b;
+  };
+  place(piece.tets);
+  place(piece.pyramids);
+  place(piece.hexes);
+  start_.assign(n + 1, 0);
+  column_.reserve(all.size() / 4);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto first = all.begin() + static_cast<std::ptrdiff_t>(fill[i]),
+               last = all.begin() + static_cast<std::ptrdiff_t>(fill[i + 1]);
+    std::sort(first, last);
+    column_.insert(column_.end(), first, std::unique(first, last));
+    start_[i + 1] = column_.size();
+  }
+  column_.shrink_to_fit();
+  mass_.resize(n);
+  recovery_.resize(3 * column_.size());
+  supg_.resize(3 * column_.size());
+  pspg_.resize(9 * column_.size());
+  gradient_.resize(9 * n);
+}
+
+std::size_t ReconstructionDerivative::edge(NodeId row, NodeId column) const {
+  const auto first = column_.begin() + static_cast<std::ptrdiff_t>(start_[row]),
+             last = column_.begin() + static_cast<std::ptrdiff_t>(start_[row + 1]);
+  return static_cast<std::size_t>(std::lower_bound(first, last, column) - column_.begin());
+}
+
+template <class E, class Cells>
+void ReconstructionDerivative::assemble_cells(const Cells& cells, const std::vector<char>& owned,
+                                              const std::vector<Eigen::Vector3d>& a, double nu) {
+  constexpr int N = E::nodes;
+  const ShapeTable<E>& table = ShapeTable<E>::get();
+  Eigen::Matrix<double, N, 3> X, A;
+  std::array<std::size_t, N * N> edges{};  // (i, j) → the edge of row i, column j
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const auto& cell = cells[k];
+    const bool mine = owned.empty() || owned[k];
+    for (int i = 0; i < N; ++i) {
+      const auto n = static_cast<std::size_t>(cell[static_cast<std::size_t>(i)]);
+      X.row(i) = mesh_.nodes[n].transpose();
+      A.row(i) = a[n].transpose();
+    }
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j)
+        edges[static_cast<std::size_t>(N * i + j)] =
+            edge(cell[static_cast<std::size_t>(i)], cell[static_cast<std::size_t>(j)]);
+    for (std::size_t q = 0; q < table.points.size(); ++q) {
+      const auto m = fem::map_to_cell<E>(X, table.shapes[q]);
+      const double w = table.points[q].weight * m.det_jacobian;
+      const Eigen::Matrix<double, N, 3>& G = m.gradient;
+      const Eigen::Vector3d aq = A.transpose() * m.value;
+      const Eigen::Matrix3d metric =
+          m.inverse_jacobian.transpose() * reference_metric<E>() * m.inverse_jacobian;
+      const double scale = w * nu * momentum_tau(aq, metric, nu);
+      const Eigen::Matrix<double, N, 1> adv = G * aq;
+      for (int i = 0; i < N; ++i) {
+        mass_[static_cast<std::size_t>(cell[static_cast<std::size_t>(i)])] += w * m.value[i];
+        for (int j = 0; j < N; ++j) {
+          const std::size_t e = edges[static_cast<std::size_t>(N * i + j)];
+          for (int d = 0; d < 3; ++d)
+            recovery_[3 * e + static_cast<std::size_t>(d)] += w * m.value[i] * G(j, d);
+          if (!mine) continue;
+          for (int d = 0; d < 3; ++d)
+            supg_[3 * e + static_cast<std::size_t>(d)] += scale * adv[i] * G(j, d);
+          for (int c = 0; c < 3; ++c)
+            for (int d = 0; d < 3; ++d)
+              pspg_[9 * e + static_cast<std::size_t>(3 * c + d)] += scale * G(i, c) * G(j, d);
+        }
+      }
+    }
+  }
+}
+
+void ReconstructionDerivative::assemble(const std::vector<Eigen::Vector3d>& a, double nu) {
+  std::fill(mass_.begin(), mass_.end(), 0.0);
+  std::fill(recovery_.begin(), recovery_.end(), 0.0f);
+  std::fill(supg_.begin(), supg_.end(), 0.0f);
+  std::fill(pspg_.begin(), pspg_.end(), 0.0f);
+  assemble_cells<fem::Tet4>(mesh_.tets, owned_.tets, a, nu);
+  assemble_cells<fem::Pyr5>(mesh_.pyramids, owned_.pyramids, a, nu);
+  assemble_cells<fem::Hex8>(mesh_.hexes, owned_.hexes, a, nu);
+  for (std::size_t j = 0; j + 1 < start_.size(); ++j) {
+    if (!(mass_[j] > 0.0)) continue;
+    for (std::size_t e = 3 * start_[j]; e < 3 * start_[j + 1]; ++e) recovery_[e] /= mass_[j];
+  }
+}
+
+void ReconstructionDerivative::apply(const double* v, double* out) {
+  // The recovered gradient of v at every piece node: g_j(c, d) = Σ_l R_jl,d v_l,c.
+  const std::size_t n = start_.size() - 1;
+  for (std::size_t j = 0; j < n; ++j) {
+    double g[9] = {};
+    for (std::size_t e = start_[j]; e < start_[j + 1]; ++e) {
+      const float* r = &recovery_[3 * e];
+      const double* vl = v + 4 * static_cast<std::size_t>(column_[e]);
+      for (int c = 0; c < 3; ++c)
+        for (int d = 0; d < 3; ++d) g[3 * c + d] += r[d] * vl[c];
+    }
+    std::copy(g, g + 9, &gradient_[9 * j]);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    double sum[4] = {};
+    for (std::size_t e = start_[i]; e < start_[i + 1]; ++e) {
+      const double* g = &gradient_[9 * static_cast<std::size_t>(column_[e])];
+      const float* s = &supg_[3 * e];
+      const float* p = &pspg_[9 * e];
+      for (int c = 0; c < 3; ++c)
+        sum[c] += s[0] * g[3 * c] + s[1] * g[3 * c + 1] + s[2] * g[3 * c + 2];
+      for (int k = 0; k < 9; ++k) sum[3] += p[k] * g[k];
+    }
+    std::copy(sum, sum + 4, out + 4 * i);
+  }
+}
+
+}  // namespace naris::ns
