@@ -166,8 +166,10 @@ SolutionState read_solution_h5(const fs::path& path) {
     c.pseudo_time = number_attribute(file.get(), "pseudo_time", path) != 0.0;
     c.earlier_reynolds = number_attribute(file.get(), "earlier_reynolds", path);
     if (!(c.next_step > 0.0) || !(c.earlier_reynolds >= 0.0) || c.earlier_reynolds >= s.reynolds)
-      fail("{}: an inconsistent continuation state (next step {}, earlier Re {} below Re {})",
-           path.string(), c.next_step, c.earlier_reynolds, s.reynolds);
+      fail(
+          "{}: an inconsistent continuation state (next step {}, earlier Re {} at Re {}: the "
+          "step must be positive and the earlier Re lower)",
+          path.string(), c.next_step, c.earlier_reynolds, s.reynolds);
     if (c.earlier_reynolds > 0.0) {
       c.earlier = read_fields(file.get(), "earlier_velocity_nondimensional",
                               "earlier_pressure_nondimensional", path);

@@ -1,6 +1,6 @@
 // Run with two MPI ranks (ctest does): the solve shared by the ranks of PETSC_COMM_WORLD —
 // each on its piece of the mesh, cells assembled where their smallest node lives, the halo of
-// the iterate refreshed after each step, block-Jacobi preconditioning —
+// the iterate refreshed after each step, additive Schwarz preconditioning —
 // reaches the same discrete solution as the solve each rank does alone on PETSC_COMM_SELF, to
 // the nonlinear tolerance, and Newton converges quadratically on the pieces; the
 // Ethier–Steinman flow on an MVE ball has every cell type.
