@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "ns/forcing_term.h"
+#include "ns/node_graph.h"
 #include "ns/oseen_element.h"
 #include "ns/preconditioner_reuse.h"
 #include "ns/reconstruction_derivative.h"
@@ -20,26 +21,6 @@ namespace naris::ns {
 namespace {
 
 using petsc::check;
-
-// For every node in [lo, hi) (local numbers), the sorted list of nodes sharing a cell with it
-// (itself included): the block sparsity of those rows.
-std::vector<std::vector<NodeId>> node_graph(const HybridMesh& mesh, NodeId lo, NodeId hi) {
-  std::vector<std::vector<NodeId>> g(static_cast<std::size_t>(hi - lo));
-  auto add = [&](const auto& cells) {
-    for (const auto& c : cells)
-      for (NodeId a : c)
-        if (a >= lo && a < hi)
-          for (NodeId b : c) g[static_cast<std::size_t>(a - lo)].push_back(b);
-  };
-  add(mesh.tets);
-  add(mesh.pyramids);
-  add(mesh.hexes);
-  for (auto& row : g) {
-    std::sort(row.begin(), row.end());
-    row.erase(std::unique(row.begin(), row.end()), row.end());
-  }
-  return g;
-}
 
 // The system over the ranks of `comm`: each rank holds its piece of the mesh
 // (parallel/partition.h) in local node numbers, owns the rows of its nodes (four each), and
@@ -71,13 +52,12 @@ class OseenSystem {
     const PetscInt local = owned;
     std::vector<PetscInt> diagonal(static_cast<std::size_t>(local)),
         off_diagonal(static_cast<std::size_t>(local));
-    for (NodeId i = 0; i < owned; ++i) {
-      const auto& row = graph[static_cast<std::size_t>(i)];
-      const auto inside =
-          std::count_if(row.begin(), row.end(), [&](NodeId j) { return numbering.owns(j); });
-      diagonal[static_cast<std::size_t>(i)] = static_cast<PetscInt>(inside);
-      off_diagonal[static_cast<std::size_t>(i)] =
-          static_cast<PetscInt>(row.size()) - static_cast<PetscInt>(inside);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(owned); ++i) {
+      const auto first = graph.column.begin() + static_cast<std::ptrdiff_t>(graph.start[i]),
+                 last = graph.column.begin() + static_cast<std::ptrdiff_t>(graph.start[i + 1]);
+      const auto inside = std::count_if(first, last, [&](NodeId j) { return numbering.owns(j); });
+      diagonal[i] = static_cast<PetscInt>(inside);
+      off_diagonal[i] = static_cast<PetscInt>(last - first) - static_cast<PetscInt>(inside);
     }
     check(MatCreate(comm, matrix_.out()), "MatCreate");
     check(MatSetSizes(matrix_, 4 * local, 4 * local, 4 * n, 4 * n), "MatSetSizes");

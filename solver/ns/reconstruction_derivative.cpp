@@ -4,56 +4,27 @@
 #include <array>
 #include <utility>
 
+#include "ns/node_graph.h"
 #include "ns/oseen_element.h"
 
 namespace naris::ns {
 
 ReconstructionDerivative::ReconstructionDerivative(const HybridMesh& piece, OwnedCells owned)
-    : mesh_(piece), owned_(std::move(owned)) {
-  const std::size_t n = piece.nodes.size();
-  // Two passes over the cells: the count of (repeated) neighbours per node, then the lists,
-  // sorted and made unique in place.
-  std::vector<std::size_t> count(n + 1, 0);
-  auto tally = [&](const auto& cells) {
-    for (const auto& c : cells)
-      for (NodeId a : c) count[static_cast<std::size_t>(a)] += c.size();
-  };
-  tally(piece.tets);
-  tally(piece.pyramids);
-  tally(piece.hexes);
-  std::vector<std::size_t> fill(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) fill[i + 1] = fill[i] + count[i];
-  std::vector<NodeId> all(fill[n]);
-  std::vector<std::size_t> at(fill.begin(), fill.end() - 1);
-  auto place = [&](const auto& cells) {
-    for (const auto& c : cells)
-      for (NodeId a : c)
-        for (NodeId b : c) all[at[static_cast<std::size_t>(a)]++] = b;
-  };
-  place(piece.tets);
-  place(piece.pyramids);
-  place(piece.hexes);
-  start_.assign(n + 1, 0);
-  column_.reserve(all.size() / 4);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto first = all.begin() + static_cast<std::ptrdiff_t>(fill[i]),
-               last = all.begin() + static_cast<std::ptrdiff_t>(fill[i + 1]);
-    std::sort(first, last);
-    column_.insert(column_.end(), first, std::unique(first, last));
-    start_[i + 1] = column_.size();
-  }
-  column_.shrink_to_fit();
-  mass_.resize(n);
-  recovery_.resize(3 * column_.size());
-  supg_.resize(3 * column_.size());
-  pspg_.resize(9 * column_.size());
-  gradient_.resize(9 * n);
+    : mesh_(piece),
+      owned_(std::move(owned)),
+      graph_(node_graph(piece, 0, static_cast<NodeId>(piece.nodes.size()))) {
+  const std::size_t edges = graph_.column.size();
+  mass_.resize(piece.nodes.size());
+  recovery_.resize(3 * edges);
+  supg_.resize(3 * edges);
+  pspg_.resize(9 * edges);
+  gradient_.resize(9 * piece.nodes.size());
 }
 
 std::size_t ReconstructionDerivative::edge(NodeId row, NodeId column) const {
-  const auto first = column_.begin() + static_cast<std::ptrdiff_t>(start_[row]),
-             last = column_.begin() + static_cast<std::ptrdiff_t>(start_[row + 1]);
-  return static_cast<std::size_t>(std::lower_bound(first, last, column) - column_.begin());
+  const auto first = graph_.column.begin() + static_cast<std::ptrdiff_t>(graph_.start[row]),
+             last = graph_.column.begin() + static_cast<std::ptrdiff_t>(graph_.start[row + 1]);
+  return static_cast<std::size_t>(std::lower_bound(first, last, column) - graph_.column.begin());
 }
 
 template <class E, class Cells>
@@ -110,20 +81,21 @@ void ReconstructionDerivative::assemble(const std::vector<Eigen::Vector3d>& a, d
   assemble_cells<fem::Tet4>(mesh_.tets, owned_.tets, a, nu);
   assemble_cells<fem::Pyr5>(mesh_.pyramids, owned_.pyramids, a, nu);
   assemble_cells<fem::Hex8>(mesh_.hexes, owned_.hexes, a, nu);
-  for (std::size_t j = 0; j + 1 < start_.size(); ++j) {
+  for (std::size_t j = 0; j + 1 < graph_.start.size(); ++j) {
     if (!(mass_[j] > 0.0)) continue;
-    for (std::size_t e = 3 * start_[j]; e < 3 * start_[j + 1]; ++e) recovery_[e] /= mass_[j];
+    for (std::size_t e = 3 * graph_.start[j]; e < 3 * graph_.start[j + 1]; ++e)
+      recovery_[e] /= mass_[j];
   }
 }
 
 void ReconstructionDerivative::apply(const double* v, double* out) {
   // The recovered gradient of v at every piece node: g_j(c, d) = Σ_l R_jl,d v_l,c.
-  const std::size_t n = start_.size() - 1;
+  const std::size_t n = graph_.start.size() - 1;
   for (std::size_t j = 0; j < n; ++j) {
     double g[9] = {};
-    for (std::size_t e = start_[j]; e < start_[j + 1]; ++e) {
+    for (std::size_t e = graph_.start[j]; e < graph_.start[j + 1]; ++e) {
       const float* r = &recovery_[3 * e];
-      const double* vl = v + 4 * static_cast<std::size_t>(column_[e]);
+      const double* vl = v + 4 * static_cast<std::size_t>(graph_.column[e]);
       for (int c = 0; c < 3; ++c)
         for (int d = 0; d < 3; ++d) g[3 * c + d] += r[d] * vl[c];
     }
@@ -131,8 +103,8 @@ void ReconstructionDerivative::apply(const double* v, double* out) {
   }
   for (std::size_t i = 0; i < n; ++i) {
     double sum[4] = {};
-    for (std::size_t e = start_[i]; e < start_[i + 1]; ++e) {
-      const double* g = &gradient_[9 * static_cast<std::size_t>(column_[e])];
+    for (std::size_t e = graph_.start[i]; e < graph_.start[i + 1]; ++e) {
+      const double* g = &gradient_[9 * static_cast<std::size_t>(graph_.column[e])];
       const float* s = &supg_[3 * e];
       const float* p = &pspg_[9 * e];
       for (int c = 0; c < 3; ++c)

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "hybrid_mesh.h"
+#include "ns/node_graph.h"
 
 namespace naris::ns {
 
@@ -51,9 +52,8 @@ class ReconstructionDerivative {
 
   const HybridMesh& mesh_;
   OwnedCells owned_;
-  std::vector<std::size_t> start_;  // per piece node, its first edge (CSR)
-  std::vector<NodeId> column_;      // per edge, the neighbour
-  std::vector<double> mass_;        // per piece node, ∫ N_j
+  NodeGraph graph_;           // of every piece node; its edges index the coefficients
+  std::vector<double> mass_;  // per piece node, ∫ N_j
   // The coefficients in single precision, 210 MB less on the neonatal airway (seven digits of
   // a term of the operator are below any tolerance its linear solves are given).
   std::vector<float> recovery_;   // 3 per edge: (1/m_j) ∫ N_j ∂_d N_l
