@@ -143,22 +143,12 @@ class OseenSystem {
     check(VecDuplicate(piece_, operand_.out()), "VecDuplicate");
     check(VecDuplicate(piece_, product_.out()), "VecDuplicate");
   }
-  // The operator at the advection (the iterate) of the last Newton assembly.
+  // The operator at the advection (the iterate) and viscosity of this Newton step.
   Mat newton_operator(const std::vector<Eigen::Vector3d>& advection, double nu) {
-    if (!derivative_) {  // allocated at first use: most runs never take such a step
-      OwnedCells owned;
-      if (!all_cells_) {
-        auto flags = [](std::size_t count, const std::vector<std::size_t>& list) {
-          std::vector<char> f(count, 0);
-          for (std::size_t c : list) f[c] = 1;
-          return f;
-        };
-        owned.tets = flags(mesh_.tets.size(), owned_tets_);
-        owned.pyramids = flags(mesh_.pyramids.size(), owned_pyramids_);
-        owned.hexes = flags(mesh_.hexes.size(), owned_hexes_);
-      }
-      derivative_.emplace(mesh_, std::move(owned));
-    }
+    // Allocated at first use: most runs never take such a step.
+    if (!derivative_)
+      derivative_.emplace(mesh_,
+                          OwnedCells{all_cells_, owned_tets_, owned_pyramids_, owned_hexes_});
     derivative_->assemble(advection, nu);
     return newton_operator_;
   }

@@ -14,11 +14,19 @@ ReconstructionDerivative::ReconstructionDerivative(const HybridMesh& piece, Owne
       owned_(std::move(owned)),
       graph_(node_graph(piece, 0, static_cast<NodeId>(piece.nodes.size()))) {
   const std::size_t edges = graph_.column.size();
-  mass_.resize(piece.nodes.size());
   recovery_.resize(3 * edges);
   supg_.resize(3 * edges);
   pspg_.resize(9 * edges);
   gradient_.resize(9 * piece.nodes.size());
+  std::vector<double> mass(piece.nodes.size(), 0.0);  // ∫ N_j
+  recovery_cells<fem::Tet4>(piece.tets, mass);
+  recovery_cells<fem::Pyr5>(piece.pyramids, mass);
+  recovery_cells<fem::Hex8>(piece.hexes, mass);
+  for (std::size_t j = 0; j < mass.size(); ++j) {
+    if (!(mass[j] > 0.0)) continue;
+    for (std::size_t e = 3 * graph_.start[j]; e < 3 * graph_.start[j + 1]; ++e)
+      recovery_[e] /= mass[j];
+  }
 }
 
 std::size_t ReconstructionDerivative::edge(NodeId row, NodeId column) const {
@@ -28,15 +36,41 @@ std::size_t ReconstructionDerivative::edge(NodeId row, NodeId column) const {
 }
 
 template <class E, class Cells>
-void ReconstructionDerivative::assemble_cells(const Cells& cells, const std::vector<char>& owned,
+void ReconstructionDerivative::recovery_cells(const Cells& cells, std::vector<double>& mass) {
+  constexpr int N = E::nodes;
+  const ShapeTable<E>& table = ShapeTable<E>::get();
+  Eigen::Matrix<double, N, 3> X;
+  for (const auto& cell : cells) {
+    for (int i = 0; i < N; ++i)
+      X.row(i) =
+          mesh_.nodes[static_cast<std::size_t>(cell[static_cast<std::size_t>(i)])].transpose();
+    for (std::size_t q = 0; q < table.points.size(); ++q) {
+      const auto m = fem::map_to_cell<E>(X, table.shapes[q]);
+      const double w = table.points[q].weight * m.det_jacobian;
+      for (int i = 0; i < N; ++i) {
+        const NodeId row = cell[static_cast<std::size_t>(i)];
+        mass[static_cast<std::size_t>(row)] += w * m.value[i];
+        for (int j = 0; j < N; ++j) {
+          const std::size_t e = edge(row, cell[static_cast<std::size_t>(j)]);
+          for (int d = 0; d < 3; ++d)
+            recovery_[3 * e + static_cast<std::size_t>(d)] += w * m.value[i] * m.gradient(j, d);
+        }
+      }
+    }
+  }
+}
+
+template <class E, class Cells>
+void ReconstructionDerivative::assemble_cells(const Cells& cells,
+                                              const std::vector<std::size_t>& owned,
                                               const std::vector<Eigen::Vector3d>& a, double nu) {
   constexpr int N = E::nodes;
   const ShapeTable<E>& table = ShapeTable<E>::get();
   Eigen::Matrix<double, N, 3> X, A;
   std::array<std::size_t, N * N> edges{};  // (i, j) → the edge of row i, column j
-  for (std::size_t k = 0; k < cells.size(); ++k) {
-    const auto& cell = cells[k];
-    const bool mine = owned.empty() || owned[k];
+  const std::size_t count = owned_.all ? cells.size() : owned.size();
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto& cell = cells[owned_.all ? k : owned[k]];
     for (int i = 0; i < N; ++i) {
       const auto n = static_cast<std::size_t>(cell[static_cast<std::size_t>(i)]);
       X.row(i) = mesh_.nodes[n].transpose();
@@ -55,37 +89,25 @@ void ReconstructionDerivative::assemble_cells(const Cells& cells, const std::vec
           m.inverse_jacobian.transpose() * reference_metric<E>() * m.inverse_jacobian;
       const double scale = w * nu * momentum_tau(aq, metric, nu);
       const Eigen::Matrix<double, N, 1> adv = G * aq;
-      for (int i = 0; i < N; ++i) {
-        mass_[static_cast<std::size_t>(cell[static_cast<std::size_t>(i)])] += w * m.value[i];
+      for (int i = 0; i < N; ++i)
         for (int j = 0; j < N; ++j) {
           const std::size_t e = edges[static_cast<std::size_t>(N * i + j)];
-          for (int d = 0; d < 3; ++d)
-            recovery_[3 * e + static_cast<std::size_t>(d)] += w * m.value[i] * G(j, d);
-          if (!mine) continue;
           for (int d = 0; d < 3; ++d)
             supg_[3 * e + static_cast<std::size_t>(d)] += scale * adv[i] * G(j, d);
           for (int c = 0; c < 3; ++c)
             for (int d = 0; d < 3; ++d)
               pspg_[9 * e + static_cast<std::size_t>(3 * c + d)] += scale * G(i, c) * G(j, d);
         }
-      }
     }
   }
 }
 
 void ReconstructionDerivative::assemble(const std::vector<Eigen::Vector3d>& a, double nu) {
-  std::fill(mass_.begin(), mass_.end(), 0.0);
-  std::fill(recovery_.begin(), recovery_.end(), 0.0f);
   std::fill(supg_.begin(), supg_.end(), 0.0f);
   std::fill(pspg_.begin(), pspg_.end(), 0.0f);
   assemble_cells<fem::Tet4>(mesh_.tets, owned_.tets, a, nu);
   assemble_cells<fem::Pyr5>(mesh_.pyramids, owned_.pyramids, a, nu);
   assemble_cells<fem::Hex8>(mesh_.hexes, owned_.hexes, a, nu);
-  for (std::size_t j = 0; j + 1 < graph_.start.size(); ++j) {
-    if (!(mass_[j] > 0.0)) continue;
-    for (std::size_t e = 3 * graph_.start[j]; e < 3 * graph_.start[j + 1]; ++e)
-      recovery_[e] /= mass_[j];
-  }
 }
 
 void ReconstructionDerivative::apply(const double* v, double* out) {

@@ -23,21 +23,23 @@
 
 namespace naris::ns {
 
-// Which cells of a piece this rank assembles (its own, as for the matrix): per cell type, a
-// flag per cell, or empty for all of them.
+// Which cells of a piece this rank assembles (its own, as for the matrix): all of them, or
+// the listed ones per cell type.
 struct OwnedCells {
-  std::vector<char> tets, pyramids, hexes;
+  bool all = true;
+  std::vector<std::size_t> tets, pyramids, hexes;
 };
 
 class ReconstructionDerivative {
  public:
-  // The node graph of a mesh piece. The piece holds every cell around the nodes of the owned
-  // cells, so the recovered gradient is complete there.
+  // The node graph of a mesh piece and R_g, which depends on the geometry only, from every
+  // cell of the piece: it holds every cell around the nodes of the owned cells, so the
+  // recovered gradient is complete there.
   ReconstructionDerivative(const HybridMesh& piece, OwnedCells owned);
 
-  // The two operators at the advection field a (one vector per piece node) and viscosity ν:
-  // R_g from every cell of the piece, B from the owned cells (rows of any piece node, which
-  // the caller adds into their owners' rows as for the assembled matrix).
+  // B at the advection field a (one vector per piece node) and viscosity ν, from the owned
+  // cells (rows of any piece node, which the caller adds into their owners' rows as for the
+  // assembled matrix).
   void assemble(const std::vector<Eigen::Vector3d>& a, double nu);
 
   // out = B R_g v, the owned cells' share, on every piece node (four values per node,
@@ -46,14 +48,15 @@ class ReconstructionDerivative {
 
  private:
   template <class E, class Cells>
-  void assemble_cells(const Cells& cells, const std::vector<char>& owned,
+  void recovery_cells(const Cells& cells, std::vector<double>& mass);
+  template <class E, class Cells>
+  void assemble_cells(const Cells& cells, const std::vector<std::size_t>& owned,
                       const std::vector<Eigen::Vector3d>& a, double nu);
   std::size_t edge(NodeId row, NodeId column) const;
 
   const HybridMesh& mesh_;
   OwnedCells owned_;
-  NodeGraph graph_;           // of every piece node; its edges index the coefficients
-  std::vector<double> mass_;  // per piece node, ∫ N_j
+  NodeGraph graph_;  // of every piece node; its edges index the coefficients
   // The coefficients in single precision, 210 MB less on the neonatal airway (seven digits of
   // a term of the operator are below any tolerance its linear solves are given).
   std::vector<float> recovery_;   // 3 per edge: (1/m_j) ∫ N_j ∂_d N_l
