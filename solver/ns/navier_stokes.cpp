@@ -149,6 +149,7 @@ class OseenSystem {
     if (!derivative_)
       derivative_.emplace(mesh_,
                           OwnedCells{all_cells_, owned_tets_, owned_pyramids_, owned_hexes_});
+    const petsc::LoggedEvent logged("NSWholeDerivative");
     derivative_->assemble(advection, nu);
     return newton_operator_;
   }
@@ -214,6 +215,7 @@ class OseenSystem {
   // also R = K(a)(a, p) − F(a), and for Newton K(a) plus the derivative terms.
   void assemble(const std::vector<Eigen::Vector3d>& advection, const std::vector<double>& pressure,
                 double nu, const BodyForce& force, Linearization linearization) {
+    const petsc::LoggedEvent logged("NSAssembly");
     recover_gradient(advection);
     check(MatZeroEntries(matrix_), "MatZeroEntries");
     check(VecSet(rhs_, 0.0), "VecSet");

@@ -37,4 +37,14 @@ int Session::size() const {
   return s;
 }
 
+LoggedEvent::LoggedEvent(const char* name) {
+  check(PetscLogEventGetId(name, &event_), "PetscLogEventGetId");
+  if (event_ < 0) check(PetscLogEventRegister(name, PETSC_OBJECT_CLASSID, &event_), name);
+  check(PetscLogEventBegin(event_, nullptr, nullptr, nullptr, nullptr), name);
+}
+
+LoggedEvent::~LoggedEvent() {
+  PetscLogEventEnd(event_, nullptr, nullptr, nullptr, nullptr);
+}
+
 }  // namespace naris::petsc

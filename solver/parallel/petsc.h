@@ -26,6 +26,21 @@ class Session {
   bool owns_ = false;
 };
 
+// naris's own work as an event of PETSc's profile (`-log_view`), beside PETSc's factorizations
+// and Krylov iterations: the time between construction and destruction, under `name`
+// (registered at first use; a name already registered is reused, so repeated solves in one
+// process add up in one row).
+class LoggedEvent {
+ public:
+  explicit LoggedEvent(const char* name);
+  ~LoggedEvent();
+  LoggedEvent(const LoggedEvent&) = delete;
+  LoggedEvent& operator=(const LoggedEvent&) = delete;
+
+ private:
+  PetscLogEvent event_ = -1;
+};
+
 template <class H, PetscErrorCode (*Destroy)(H*)>
 class Handle {
  public:

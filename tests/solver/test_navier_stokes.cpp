@@ -212,6 +212,32 @@ TEST(NavierStokes, NewtonConvergesQuadraticallyWithTheWholeDerivative) {
                                  << h[last];
 }
 
+// naris's own work shows in PETSc's profile (-log_view) beside PETSc's events: every
+// assembly, and the whole derivative's, once per Newton step that uses it.
+TEST(NavierStokes, AssemblyIsAnEventOfPetscsProfile) {
+  petsc::check(PetscLogDefaultBegin(), "PetscLogDefaultBegin");
+  const auto count = [](const char* name) {
+    PetscLogEvent event = -1;
+    petsc::check(PetscLogEventGetId(name, &event), "PetscLogEventGetId");
+    if (event < 0) return 0;
+    PetscEventPerfInfo info{};
+    petsc::check(PetscLogEventGetPerfInfo(0, event, &info), "PetscLogEventGetPerfInfo");
+    return info.count;
+  };
+  const int assemblies = count("NSAssembly"), derivatives = count("NSWholeDerivative");
+  const BeltramiBall problem;
+  PicardOptions o;
+  o.tolerance = 1e-10;
+  o.max_iterations = 30;
+  PicardReport report;
+  solve_navier_stokes(problem.mesh, problem.nu, problem.force, problem.bc, o, &report);
+  ASSERT_TRUE(report.converged);
+  // One assembly per nonlinear step and the Stokes start; the residual that ends the
+  // iteration is an assembly too. Newton follows the Picard steps with the whole derivative.
+  EXPECT_EQ(count("NSAssembly") - assemblies, report.iterations + 2);
+  EXPECT_EQ(count("NSWholeDerivative") - derivatives, report.iterations - o.picard_steps);
+}
+
 // An iteration that crawls — here Picard held to 5 % steps, so the residual falls a few
 // percent a step — is given up once it has not halved over `stall_steps` steps, long before
 // max_iterations; left alone it would go on.
