@@ -103,7 +103,7 @@ void add_solve_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("!--rebuild-preconditioner", job.picard.reuse_preconditioner,
                 "set the linear solver's preconditioner up anew for every nonlinear step (by "
-                "default it is kept while that saves time)");
+                "default it is kept while that saves work)");
   cmd->add_option("--relaxation", job.picard.relaxation,
                   "largest step fraction (0, 1]; the step is cut back while the residual grows")
       ->check(CLI::Range(0.01, 1.0))

@@ -10,10 +10,10 @@ namespace naris::ns {
 // went to the factorizations), and consecutive Picard or Newton matrices differ little near
 // the solution; but a kept factorization costs iterations as the matrix drifts away from it.
 // It is rebuilt for a new kind of linearization, and once the iterations the last solve added
-// over the first one after the build cost more time than a build; after a kept solve has run
-// out of its budget, it is no longer kept at all (for the rest of that nonlinear solve).
-// Solves to different tolerances (forcing_term.h) are compared by their iterations per decade
-// of residual reduction.
+// over the first one after the build cost more than a build; after a kept solve has run out of
+// its budget, it is no longer kept at all (for the rest of that nonlinear solve). Costs are in
+// any one unit (the solver passes floating-point operations). Solves to different tolerances
+// (forcing_term.h) are compared by their iterations per decade of residual reduction.
 enum class LinearProblem { stokes, picard, newton };
 
 class PreconditionerReuse {
@@ -21,18 +21,18 @@ class PreconditionerReuse {
   explicit PreconditionerReuse(bool enabled) : enabled_(enabled) {}
   bool keeps(LinearProblem kind) const { return enabled_ && built_ && kind == kind_ && !stale_; }
   // `decades`: the reduction the solve was asked for, log10(1/tolerance).
-  void built(LinearProblem kind, double setup_seconds, double solve_seconds, int iterations,
+  void built(LinearProblem kind, double setup_cost, double solve_cost, int iterations,
              double decades) {
     built_ = true;
     stale_ = false;
     kind_ = kind;
-    setup_seconds_ = setup_seconds;
+    setup_cost_ = setup_cost;
     fresh_rate_ = iterations / std::max(decades, 0.1);
-    seconds_per_iteration_ = solve_seconds / std::max(iterations, 1);
+    cost_per_iteration_ = solve_cost / std::max(iterations, 1);
   }
-  void kept(double solve_seconds, int iterations, double decades) {
-    if (iterations > 0) seconds_per_iteration_ = solve_seconds / iterations;
-    stale_ = (iterations - fresh_iterations(decades)) * seconds_per_iteration_ > setup_seconds_;
+  void kept(double solve_cost, int iterations, double decades) {
+    if (iterations > 0) cost_per_iteration_ = solve_cost / iterations;
+    stale_ = (iterations - fresh_iterations(decades)) * cost_per_iteration_ > setup_cost_;
   }
   // A kept solve ran out of its budget (or failed): the matrices change too fast for keeping
   // to pay (under pseudo-time on the neonatal airway near Re 470 every other kept solve ran out,
@@ -43,7 +43,7 @@ class PreconditionerReuse {
   // factorization that went bad costs at most twice what rebuilding at once would have (on the
   // neonatal airway a kept ILU once took 276 iterations where a fresh one took 91).
   int iteration_budget(double decades) const {
-    const double extra = setup_seconds_ / std::max(seconds_per_iteration_, 1e-12);
+    const double extra = setup_cost_ / std::max(cost_per_iteration_, 1e-12);
     return static_cast<int>(std::ceil(fresh_iterations(decades)) + std::min(extra, 1e6)) + 1;
   }
 
@@ -53,7 +53,7 @@ class PreconditionerReuse {
   // What a fresh preconditioner would take for this reduction.
   double fresh_iterations(double decades) const { return fresh_rate_ * std::max(decades, 0.1); }
 
-  double setup_seconds_ = 0.0, seconds_per_iteration_ = 0.0;
+  double setup_cost_ = 0.0, cost_per_iteration_ = 0.0;
   double fresh_rate_ = 0.0;  // iterations per decade with a fresh preconditioner
 };
 

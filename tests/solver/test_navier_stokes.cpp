@@ -290,9 +290,9 @@ TEST(NavierStokes, KeptPreconditionerReachesTheSameSolution) {
   EXPECT_LT(dp, 1e-7 * pscale);
 }
 
-// The rule itself, on made-up timings: a build costs 2 s, a fresh solve 100 iterations of
-// 10 ms for 3 decades (a tolerance of 1e-3). A kept preconditioner stays while the iterations
-// it adds cost less than a build.
+// The rule itself, on made-up costs (seconds here; the solver counts operations): a build
+// costs 2 s, a fresh solve 100 iterations of 10 ms for 3 decades (a tolerance of 1e-3). A kept
+// preconditioner stays while the iterations it adds cost less than a build.
 TEST(PreconditionerReuse, KeepsWhileTheAddedIterationsCostLessThanABuild) {
   PreconditionerReuse reuse(true);
   EXPECT_FALSE(reuse.keeps(LinearProblem::stokes));  // nothing built yet
