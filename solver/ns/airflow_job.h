@@ -28,7 +28,7 @@ struct AirflowJob {
   // picard.tolerance, which holds at the target): they only start the next one. Looser is
   // not safely cheaper: on the neonatal airway from Re 50 to 300, 1e-4 took 89 nonlinear steps
   // on one rank where 1e-5 took 95, but on two ranks its Re 237.5 step diverged (residual
-  // 1e33) and the continuation took 154 steps; 1e-3 took 111 on one rank.
+  // 1e33) and the continuation took 154 steps where 1e-5 took 99; 1e-3 took 111 on one rank.
   double step_tolerance = 1e-5;
   PicardOptions picard;  // per step
   // Resume from this checkpoint (a solution file of the same mesh) instead of starting low.

@@ -648,7 +648,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
         // preconditioner is kept, and with it the path of the iteration, does not depend on
         // the machine's load. (Timed, two runs of the neonate's Re 237.5 step parted at the
         // fifth Newton step and took 38 and 47 steps.) The factorization and the Krylov
-        // iterations run at much the same rate (4–6 Gflop/s there), so the counts weigh them
+        // iterations run at much the same rate (3.9–6.3 Gflop/s there), so the counts weigh them
         // as time would.
         PetscLogDouble start = 0.0, set_up = 0.0, solved = 0.0;
         check(PetscGetFlops(&start), "PetscGetFlops");
