@@ -14,6 +14,7 @@
 #include "ns/preconditioner_reuse.h"
 #include "ns/reconstruction_derivative.h"
 #include "ns/segregated_step.h"
+#include "parallel/block_assembly.h"
 #include "parallel/partition.h"
 #include "parallel/petsc.h"
 
@@ -89,6 +90,7 @@ class OseenSystem {
           "ISCreateBlock");
     check(VecCreateSeq(PETSC_COMM_SELF, 4 * nodes, piece_.out()), "VecCreateSeq");
     check(VecScatterCreate(rhs_, from, piece_, nullptr, gather_.out()), "VecScatterCreate");
+    insertion_.emplace(matrix_, numbering_);
   }
 
   bool owns(NodeId node) const { return numbering_.owns(node); }
@@ -223,10 +225,12 @@ class OseenSystem {
     const auto f = [&](const Eigen::Vector3d& x) -> Eigen::Vector3d {
       return force ? force(x) : Eigen::Vector3d::Zero();
     };
+    insertion_->begin();
     assemble_cells<fem::Tet4>(mesh_.tets, owned_tets_, advection, pressure, nu, f, linearization);
     assemble_cells<fem::Pyr5>(mesh_.pyramids, owned_pyramids_, advection, pressure, nu, f,
                               linearization);
     assemble_cells<fem::Hex8>(mesh_.hexes, owned_hexes_, advection, pressure, nu, f, linearization);
+    insertion_->end();
     // The piece holds the boundary faces this rank owns.
     if (backflow_patch_ >= 0) assemble_backflow(advection, linearization);
     check(MatAssemblyBegin(matrix_, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
@@ -324,8 +328,6 @@ class OseenSystem {
     Eigen::Matrix<double, N, 1> p;
     Eigen::Matrix<double, N, 9> grad;
     ElementSystem<N> sys;
-    // PETSc takes the block matrix row-major.
-    Eigen::Matrix<double, 4 * N, 4 * N, Eigen::RowMajor> K;
     std::array<PetscInt, N> blocks;
     const std::size_t count = all_cells_ ? all.size() : owned.size();
     for (std::size_t k = 0; k < count; ++k) {
@@ -339,9 +341,7 @@ class OseenSystem {
         blocks[static_cast<std::size_t>(i)] = block(cell[static_cast<std::size_t>(i)]);
       }
       oseen_element<E>(X, a, &grad, nu, force, sys, p, linearization);
-      K = sys.K;
-      check(MatSetValuesBlocked(matrix_, N, blocks.data(), N, blocks.data(), K.data(), ADD_VALUES),
-            "MatSetValuesBlocked");
+      insertion_->add(std::span<const NodeId>(cell.data(), N), sys.K.data());
       check(VecSetValuesBlocked(rhs_, N, blocks.data(), sys.F.data(), ADD_VALUES),
             "VecSetValuesBlocked");
       if (linearization != Linearization::picard)
@@ -384,6 +384,7 @@ class OseenSystem {
   int backflow_patch_ = -1;
   double backflow_beta_ = 0.0;
   petsc::Matrix matrix_;
+  std::optional<parallel::BlockAssembly> insertion_;  // the cells' matrices into matrix_
   int rank_ = 0;
   bool all_cells_ = true;  // the whole mesh on one rank: every cell, no lists
   std::vector<std::size_t> owned_tets_, owned_pyramids_, owned_hexes_;  // assembled here

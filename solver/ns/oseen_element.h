@@ -165,15 +165,15 @@ void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
       Eigen::Vector4d by_tau;
       for (int c = 0; c < 3; ++c) by_tau[c] = adv[i] * r[c] - tau_c / tau_m * divergence * G(i, c);
       by_tau[3] = G.row(i).dot(r);
-      for (int j = 0; j < N; ++j) {
-        const double wj = w * Nv[j];
+      // Row block i's derivative is this 4×3 block times N_j: formed once, not per column.
+      Eigen::Matrix<double, 4, 3> row_block;
+      for (int d = 0; d < 3; ++d) {
         for (int c = 0; c < 3; ++c)
-          for (int d = 0; d < 3; ++d)
-            out.newton(4 * i + c, 4 * j + d) +=
-                wj * (test * grad_u(c, d) + tau_m * G(i, d) * r[c] + dtau[d] * by_tau[c]);
-        for (int d = 0; d < 3; ++d)
-          out.newton(4 * i + 3, 4 * j + d) += wj * (pspg[d] + dtau[d] * by_tau[3]);
+          row_block(c, d) = test * grad_u(c, d) + tau_m * G(i, d) * r[c] + dtau[d] * by_tau[c];
+        row_block(3, d) = pspg[d] + dtau[d] * by_tau[3];
       }
+      for (int j = 0; j < N; ++j)
+        out.newton.template block<4, 3>(4 * i, 4 * j) += (w * Nv[j]) * row_block;
     }
   }
   if (linearization == Linearization::picard) return;

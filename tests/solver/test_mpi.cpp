@@ -12,6 +12,9 @@
 #include "manufactured.h"
 #include "meshes.h"
 #include "ns/navier_stokes.h"
+#include "ns/node_graph.h"
+#include "parallel/block_assembly.h"
+#include "parallel/partition.h"
 #include "parallel/petsc.h"
 
 namespace naris::ns {
@@ -74,6 +77,103 @@ TEST(Mpi, SeveralRanksReachTheSerialSolution) {
   ASSERT_GE(last, 3u);
   EXPECT_LT(h[last] / h[last - 1], 0.1 * h[last - 1] / h[last - 2])
       << h[last - 2] << ", " << h[last - 1] << ", " << h[last];
+}
+
+// The 4×4-block matrix over the piece's owned nodes, preallocated from its cells, of type
+// `type`; every cell the rank owns adds a matrix that depends only on the cell's global nodes,
+// through BlockAssembly (`direct`) or through MatSetValuesBlocked.
+petsc::Matrix element_sum(const HybridMesh& mesh, const parallel::NodeNumbering& numbering,
+                          MPI_Comm comm, MatType type, bool direct, int passes,
+                          bool* last_pass_direct = nullptr) {
+  const auto graph = node_graph(mesh, 0, numbering.owned);
+  std::vector<PetscInt> diagonal(static_cast<std::size_t>(numbering.owned)),
+      off_diagonal(diagonal.size());
+  for (std::size_t i = 0; i < diagonal.size(); ++i)
+    for (std::size_t k = graph.start[i]; k < graph.start[i + 1]; ++k)
+      ++(numbering.owns(graph.column[k]) ? diagonal[i] : off_diagonal[i]);
+  petsc::Matrix m;
+  const auto n = static_cast<PetscInt>(numbering.global_nodes);
+  petsc::check(MatCreate(comm, m.out()), "MatCreate");
+  petsc::check(MatSetSizes(m, 4 * numbering.owned, 4 * numbering.owned, 4 * n, 4 * n),
+               "MatSetSizes");
+  petsc::check(MatSetType(m, type), "MatSetType");
+  petsc::check(MatSetBlockSize(m, 4), "MatSetBlockSize");
+  petsc::check(
+      MatXAIJSetPreallocation(m, 4, diagonal.data(), off_diagonal.data(), nullptr, nullptr),
+      "MatXAIJSetPreallocation");
+  petsc::check(MatSetOption(m, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+  parallel::BlockAssembly insertion(m, numbering);
+  for (int pass = 0; pass < passes; ++pass) {
+    petsc::check(MatZeroEntries(m), "MatZeroEntries");
+    insertion.begin();
+    if (last_pass_direct) *last_pass_direct = insertion.adds_directly();
+    auto add = [&](const auto& cells) {
+      constexpr std::size_t N = std::tuple_size_v<std::decay_t<decltype(cells[0])>>;
+      Eigen::Matrix<double, 4 * N, 4 * N> K;
+      Eigen::Matrix<double, 4 * N, 4 * N, Eigen::RowMajor> row_major;
+      std::array<PetscInt, N> global{};
+      for (const auto& cell : cells) {
+        if (!numbering.owns_cell(cell)) continue;
+        for (std::size_t i = 0; i < N; ++i) global[i] = numbering.to_global(cell[i]);
+        for (int r = 0; r < K.rows(); ++r)
+          for (int c = 0; c < K.cols(); ++c)
+            K(r, c) =
+                std::sin(0.37 * global[static_cast<std::size_t>(r / 4)] + 0.11 * (r % 4) +
+                         1.3 * global[static_cast<std::size_t>(c / 4)] + 0.7 * (c % 4) + pass);
+        if (direct) {
+          insertion.add(std::span<const NodeId>(cell.data(), N), K.data());
+        } else {
+          row_major = K;
+          petsc::check(MatSetValuesBlocked(m, N, global.data(), N, global.data(), row_major.data(),
+                                           ADD_VALUES),
+                       "MatSetValuesBlocked");
+        }
+      }
+    };
+    add(mesh.tets);
+    add(mesh.pyramids);
+    add(mesh.hexes);
+    insertion.end();
+    petsc::check(MatAssemblyBegin(m, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+    petsc::check(MatAssemblyEnd(m, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  }
+  return m;
+}
+
+// Element matrices written straight into the block arrays (after the first assembly, which
+// fixes the pattern) sum to the matrix MatSetValuesBlocked builds, on one rank and on the
+// pieces of several, and a matrix type without blocks takes them through PETSc unchanged.
+TEST(Mpi, BlockAssemblyAddsWhatMatSetValuesBlockedAdds) {
+  int ranks = 1, rank = 0;
+  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  const HybridMesh whole = testing::convergence_mesh("mve-ball", 6);
+  ASSERT_GT(whole.pyramids.size(), 0u);
+  const auto piece = parallel::mesh_piece(whole, rank, ranks);
+  const auto serial = parallel::whole_numbering(whole.nodes.size());
+  struct Case {
+    const HybridMesh& mesh;
+    const parallel::NodeNumbering& numbering;
+    MPI_Comm comm;
+  };
+  for (const Case& c : {Case{whole, serial, PETSC_COMM_SELF},
+                        Case{piece.mesh, piece.numbering, PETSC_COMM_WORLD}}) {
+    const auto reference = element_sum(c.mesh, c.numbering, c.comm, MATBAIJ, false, 2);
+    for (MatType type : {MATBAIJ, MATAIJ}) {
+      bool straight = false;
+      const auto direct = element_sum(c.mesh, c.numbering, c.comm, type, true, 2, &straight);
+      EXPECT_EQ(straight, std::string(type) == MATBAIJ);
+      PetscReal size = 0.0, difference = 0.0;
+      petsc::check(MatNorm(reference, NORM_FROBENIUS, &size), "MatNorm");
+      petsc::Matrix d;
+      petsc::check(MatConvert(direct, MATBAIJ, MAT_INITIAL_MATRIX, d.out()), "MatConvert");
+      petsc::check(MatAXPY(d, -1.0, reference, DIFFERENT_NONZERO_PATTERN), "MatAXPY");
+      petsc::check(MatNorm(d, NORM_FROBENIUS, &difference), "MatNorm");
+      EXPECT_GT(size, 1.0);
+      EXPECT_LE(difference, 1e-14 * size)
+          << type << " on " << (c.comm == PETSC_COMM_SELF ? 1 : ranks) << " ranks";
+    }
+  }
 }
 
 }  // namespace
