@@ -48,30 +48,10 @@ class OseenSystem {
       owned_cells(mesh.pyramids, owned_pyramids_);
       owned_cells(mesh.hexes, owned_hexes_);
     }
-    const NodeId owned = numbering.owned;
-    const auto graph = node_graph(mesh, 0, owned);
-    const PetscInt local = owned;
-    std::vector<PetscInt> diagonal(static_cast<std::size_t>(local)),
-        off_diagonal(static_cast<std::size_t>(local));
-    for (std::size_t i = 0; i < static_cast<std::size_t>(owned); ++i) {
-      const auto first = graph.column.begin() + static_cast<std::ptrdiff_t>(graph.start[i]),
-                 last = graph.column.begin() + static_cast<std::ptrdiff_t>(graph.start[i + 1]);
-      const auto inside = std::count_if(first, last, [&](NodeId j) { return numbering.owns(j); });
-      diagonal[i] = static_cast<PetscInt>(inside);
-      off_diagonal[i] = static_cast<PetscInt>(last - first) - static_cast<PetscInt>(inside);
-    }
-    check(MatCreate(comm, matrix_.out()), "MatCreate");
-    check(MatSetSizes(matrix_, 4 * local, 4 * local, 4 * n, 4 * n), "MatSetSizes");
+    const PetscInt local = numbering.owned;
     // 4×4 blocks by default (a third less memory and faster ILU); `-ns_mat_type aij` for
     // preconditioners that split the fields inside a block (fieldsplit).
-    check(MatSetType(matrix_, type), "MatSetType");
-    check(MatSetBlockSize(matrix_, 4), "MatSetBlockSize");
-    check(MatSetOptionsPrefix(matrix_, prefix.c_str()), "MatSetOptionsPrefix");
-    check(MatSetFromOptions(matrix_), "MatSetFromOptions");
-    check(
-        MatXAIJSetPreallocation(matrix_, 4, diagonal.data(), off_diagonal.data(), nullptr, nullptr),
-        "MatXAIJSetPreallocation");
-    check(MatSetOption(matrix_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+    matrix_ = block_matrix(mesh, numbering, comm, type, prefix);
     // Dirichlet rows are zeroed every iteration; their pattern must survive for the next one.
     check(MatSetOption(matrix_, MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE), "MatSetOption");
     check(VecCreate(comm, rhs_.out()), "VecCreate");

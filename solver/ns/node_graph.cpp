@@ -45,4 +45,32 @@ NodeGraph node_graph(const HybridMesh& mesh, NodeId lo, NodeId hi) {
   return g;
 }
 
+petsc::Matrix block_matrix(const HybridMesh& mesh, const parallel::NodeNumbering& numbering,
+                           MPI_Comm comm, MatType type, const std::string& prefix) {
+  using petsc::check;
+  const auto graph = node_graph(mesh, 0, numbering.owned);
+  const auto local = static_cast<PetscInt>(numbering.owned);
+  const auto n = static_cast<PetscInt>(numbering.global_nodes);
+  std::vector<PetscInt> diagonal(static_cast<std::size_t>(local)),
+      off_diagonal(static_cast<std::size_t>(local));
+  for (std::size_t i = 0; i < diagonal.size(); ++i) {
+    const auto first = graph.column.begin() + static_cast<std::ptrdiff_t>(graph.start[i]),
+               last = graph.column.begin() + static_cast<std::ptrdiff_t>(graph.start[i + 1]);
+    const auto inside = std::count_if(first, last, [&](NodeId j) { return numbering.owns(j); });
+    diagonal[i] = static_cast<PetscInt>(inside);
+    off_diagonal[i] = static_cast<PetscInt>(last - first) - static_cast<PetscInt>(inside);
+  }
+  petsc::Matrix matrix;
+  check(MatCreate(comm, matrix.out()), "MatCreate");
+  check(MatSetSizes(matrix, 4 * local, 4 * local, 4 * n, 4 * n), "MatSetSizes");
+  check(MatSetType(matrix, type), "MatSetType");
+  check(MatSetBlockSize(matrix, 4), "MatSetBlockSize");
+  check(MatSetOptionsPrefix(matrix, prefix.c_str()), "MatSetOptionsPrefix");
+  check(MatSetFromOptions(matrix), "MatSetFromOptions");
+  check(MatXAIJSetPreallocation(matrix, 4, diagonal.data(), off_diagonal.data(), nullptr, nullptr),
+        "MatXAIJSetPreallocation");
+  check(MatSetOption(matrix, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+  return matrix;
+}
+
 }  // namespace naris::ns

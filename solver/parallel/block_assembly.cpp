@@ -73,7 +73,10 @@ void BlockAssembly::begin() {
     if (!done) fail("internal: no row structure for the off-diagonal block");
     petsc::check(MatSeqBAIJGetArray(off_diagonal_, &off_values_), "MatSeqBAIJGetArray");
     // The off-diagonal part numbers its columns by position in garray (the sorted global
-    // numbers of the columns it holds); the halo's local numbers follow global order too.
+    // numbers of the columns it holds); the halo's local numbers follow global order too. The
+    // pattern is fixed after the first assembly, and with it this map.
+    if (halo_mapped_) return;
+    halo_mapped_ = true;
     PetscInt columns = 0;
     petsc::check(MatGetLocalSize(off_diagonal_, nullptr, &columns), "MatGetLocalSize");
     const PetscInt* last = garray + columns / 4;

@@ -2,8 +2,8 @@
 // Element matrices added straight into the value arrays of a 4×4-block PETSc matrix (BAIJ,
 // sequential or MPI) once its nonzero pattern is final. MatSetValuesBlocked searches every
 // block's column in its row and transposes the caller's row-major values block by block: on
-// the neonatal airway that was a third of each assembly. Here each column is found by a binary
-// search in the row's sorted block columns and each block column of the element matrix
+// the neonatal airway that was over a quarter of each assembly. Here each column is found by a
+// binary search in the row's sorted block columns and each block column of the element matrix
 // (column-major, as the element kernels build it) lands as four contiguous values — PETSc
 // stores a block column-major too. Rows another rank owns still go through
 // MatSetValuesBlocked and its stash, as do all rows before the first assembly (the pattern is
@@ -49,8 +49,9 @@ class BlockAssembly {
   const PetscInt *off_row_ = nullptr, *off_column_ = nullptr;
   PetscScalar *diagonal_values_ = nullptr, *off_values_ = nullptr;
   std::vector<PetscInt> halo_column_;  // per halo node: its column in the off-diagonal part
-  std::vector<PetscInt> global_;       // scratch: global block numbers of an element
-  std::vector<double> row_values_;     // scratch: block rows, row-major, for PETSc
+  bool halo_mapped_ = false;
+  std::vector<PetscInt> global_;    // scratch: global block numbers of an element
+  std::vector<double> row_values_;  // scratch: block rows, row-major, for PETSc
 };
 
 }  // namespace naris::parallel

@@ -79,29 +79,13 @@ TEST(Mpi, SeveralRanksReachTheSerialSolution) {
       << h[last - 2] << ", " << h[last - 1] << ", " << h[last];
 }
 
-// The 4×4-block matrix over the piece's owned nodes, preallocated from its cells, of type
-// `type`; every cell the rank owns adds a matrix that depends only on the cell's global nodes,
-// through BlockAssembly (`direct`) or through MatSetValuesBlocked.
+// The solver's 4×4-block matrix of type `type` over the piece's owned nodes; every cell the rank
+// owns adds a matrix that depends only on the cell's global nodes, through BlockAssembly (`direct`)
+// or through MatSetValuesBlocked.
 petsc::Matrix element_sum(const HybridMesh& mesh, const parallel::NodeNumbering& numbering,
                           MPI_Comm comm, MatType type, bool direct, int passes,
                           bool* last_pass_direct = nullptr) {
-  const auto graph = node_graph(mesh, 0, numbering.owned);
-  std::vector<PetscInt> diagonal(static_cast<std::size_t>(numbering.owned)),
-      off_diagonal(diagonal.size());
-  for (std::size_t i = 0; i < diagonal.size(); ++i)
-    for (std::size_t k = graph.start[i]; k < graph.start[i + 1]; ++k)
-      ++(numbering.owns(graph.column[k]) ? diagonal[i] : off_diagonal[i]);
-  petsc::Matrix m;
-  const auto n = static_cast<PetscInt>(numbering.global_nodes);
-  petsc::check(MatCreate(comm, m.out()), "MatCreate");
-  petsc::check(MatSetSizes(m, 4 * numbering.owned, 4 * numbering.owned, 4 * n, 4 * n),
-               "MatSetSizes");
-  petsc::check(MatSetType(m, type), "MatSetType");
-  petsc::check(MatSetBlockSize(m, 4), "MatSetBlockSize");
-  petsc::check(
-      MatXAIJSetPreallocation(m, 4, diagonal.data(), off_diagonal.data(), nullptr, nullptr),
-      "MatXAIJSetPreallocation");
-  petsc::check(MatSetOption(m, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+  petsc::Matrix m = block_matrix(mesh, numbering, comm, type, "");
   parallel::BlockAssembly insertion(m, numbering);
   for (int pass = 0; pass < passes; ++pass) {
     petsc::check(MatZeroEntries(m), "MatZeroEntries");
