@@ -27,7 +27,7 @@ class PreconditionerReuse {
     stale_ = false;
     kind_ = kind;
     setup_cost_ = setup_cost;
-    fresh_rate_ = iterations / std::max(decades, 0.1);
+    fresh_rate_ = iterations / counted(decades);
     cost_per_iteration_ = solve_cost / std::max(iterations, 1);
   }
   void kept(double solve_cost, int iterations, double decades) {
@@ -51,7 +51,9 @@ class PreconditionerReuse {
   bool enabled_ = false, built_ = false, stale_ = false;
   LinearProblem kind_ = LinearProblem::stokes;
   // What a fresh preconditioner would take for this reduction.
-  double fresh_iterations(double decades) const { return fresh_rate_ * std::max(decades, 0.1); }
+  double fresh_iterations(double decades) const { return fresh_rate_ * counted(decades); }
+  // A solve asked for (almost) no reduction still counts as a tenth of a decade.
+  static double counted(double decades) { return std::max(decades, 0.1); }
 
   double setup_cost_ = 0.0, cost_per_iteration_ = 0.0;
   double fresh_rate_ = 0.0;  // iterations per decade with a fresh preconditioner

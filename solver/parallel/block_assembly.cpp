@@ -134,6 +134,7 @@ double* BlockAssembly::find(NodeId row, NodeId column) const {
 
 void BlockAssembly::add(std::span<const NodeId> nodes, const double* K) {
   const std::size_t n = nodes.size(), ld = 4 * n;
+  global_.clear();  // filled by the first row that goes through PETSc
   if (!direct_) {
     add_through_petsc(nodes, 0, n, K);
     return;
@@ -153,9 +154,9 @@ void BlockAssembly::add(std::span<const NodeId> nodes, const double* K) {
 void BlockAssembly::add_through_petsc(std::span<const NodeId> nodes, std::size_t first,
                                       std::size_t last, const double* K) {
   const std::size_t n = nodes.size(), ld = 4 * n;
-  global_.resize(n);
+  if (global_.empty())
+    for (NodeId v : nodes) global_.push_back(numbering_.to_global(v));
   row_values_.resize(4 * (last - first) * ld);
-  for (std::size_t j = 0; j < n; ++j) global_[j] = numbering_.to_global(nodes[j]);
   for (std::size_t r = 4 * first; r < 4 * last; ++r)
     for (std::size_t col = 0; col < ld; ++col)
       row_values_[(r - 4 * first) * ld + col] = K[col * ld + r];
