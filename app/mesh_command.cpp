@@ -43,6 +43,12 @@ void add_mesh_command(CLI::App& app) {
                   "improvement: collapse edges shorter than this fraction of the voxel size")
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
+  cmd->add_option("--subdivide", options_job->subdivisions,
+                  "refine N times after the improvement, each time every cell into 8 of half "
+                  "its size filling the same volume (same wall, inlet and outlet; for "
+                  "mesh-convergence studies)")
+      ->check(CLI::Range(0, 3))
+      ->capture_default_str();
   cmd->add_flag("--all-components", opt->all_components,
                 "keep every connected component (default: the largest only)");
   cmd->add_flag("--no-check", opt->no_check, "skip the conformity/watertightness check");

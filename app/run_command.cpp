@@ -220,6 +220,7 @@ void run_case(const RunOptions& o) {
     mesh_s.get("threshold", threshold);
     mesh_s.get("improve", improve);
     mesh_s.get("min_edge", job->improve_options.min_edge_fraction);
+    mesh_s.get("subdivide", job->subdivisions);
     mesh_s.get("msh", msh);
     mesh_s.finish();
     if (!inlet.empty()) job->inlet = inlet;

@@ -27,6 +27,9 @@ struct MeshJob {
   bool keep_largest = true;
   bool improve = true;
   ImproveOptions improve_options;
+  // Uniform refinements after the improvement (refine/subdivide.h): each multiplies the cells
+  // by 8 and keeps the geometry, for mesh-convergence studies on one anatomy.
+  int subdivisions = 0;
   bool check = true;  // verify conformity and watertightness (costs a sort of all faces)
   std::filesystem::path output = "mesh.h5";
   bool write_vtu = true, write_stl = true, write_msh = true;
@@ -39,6 +42,7 @@ struct MeshJobResult {
   std::string mode;    // "label", "below" or "above"
   mve::MveStats mve;
   ImproveStats improvement;
+  std::size_t cells_before_subdivision = 0;  // with subdivisions
   QualityReport before, after;
   std::vector<CellQuality> quality;  // per cell of the final mesh, in its cell order
   std::vector<PatchReport> patches;

@@ -111,6 +111,41 @@ TEST_F(Cli, MeshesABallAndWritesEveryFile) {
   EXPECT_NE(r.err.find("conforming, watertight"), std::string::npos) << r.err;
 }
 
+// Subdivision refines the mesh without moving its boundary: the inlet keeps its area and
+// perimeter (so the solver's d_in and U_in), the volume stays, the cells grow 8–10×.
+TEST_F(Cli, SubdivideRefinesTheSameGeometry) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  auto mesh_json = [](const fs::path& folder) {
+    std::ifstream file(folder / "mesh.json");
+    return std::string((std::istreambuf_iterator<char>(file)), {});
+  };
+  auto number = [](const std::string& text, const std::string& pattern) {
+    std::smatch m;
+    if (!std::regex_search(text, m, std::regex(pattern)))
+      ADD_FAILURE() << pattern << " in " << text;
+    return m.empty() ? NAN : std::stod(m[1]);
+  };
+  const std::string cells = "\"tet\": ([0-9]+)", volume = "\"volume_mm3\": ([-0-9.e+]+)",
+                    area = "\"name\": \"inlet\", \"faces\": [0-9]+, \"area_mm2\": ([-0-9.e+]+)",
+                    perimeter = "\"name\": \"inlet\".*?\"perimeter_mm\": ([-0-9.e+]+)";
+  const fs::path coarse = dir_ / "coarse", fine = dir_ / "fine";
+  ASSERT_EQ(
+      naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + (coarse / "mesh.h5").string())
+          .status,
+      0);
+  const CliRun r = naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 --subdivide 1 -o " +
+                         (fine / "mesh.h5").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("subdivided 1×"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("conforming, watertight"), std::string::npos) << r.err;
+  const std::string a = mesh_json(coarse), b = mesh_json(fine);
+  EXPECT_GE(number(b, cells), 8 * number(a, cells));
+  EXPECT_NEAR(number(b, volume), number(a, volume), 1e-5 * number(a, volume));
+  EXPECT_NEAR(number(b, area), number(a, area), 1e-5 * number(a, area));
+  EXPECT_NEAR(number(b, perimeter), number(a, perimeter), 1e-5 * number(a, perimeter));
+  expect_clean_failure(naris("mesh " + in.string() + " --subdivide 5 " + out()), "--subdivide");
+}
+
 TEST_F(Cli, QuietPrintsNothing) {
   const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
   const CliRun r = naris("--quiet mesh " + in.string() + " " + out());
