@@ -75,25 +75,30 @@ class NewNodes {
   }
   NodeId hex(std::size_t h) const { return hex_id_[h]; }
 
-  BigVector<Eigen::Vector3d> coordinates() const {
-    const auto& x = mesh_.nodes;
-    BigVector<Eigen::Vector3d> out(original_.size() + edge_id_.size() + quad_id_.size() +
-                                   hex_id_.size());
-    for (std::size_t i = 0; i < x.size(); ++i) out[original_[i]] = x[i];
+  Prolongation prolongation() const {
+    const std::size_t total = original_.size() + edge_id_.size() + quad_id_.size() + hex_id_.size();
+    Prolongation p;
+    p.offsets.assign(total + 1, 0);
+    for (NodeId id : original_) p.offsets[static_cast<std::size_t>(id) + 1] = 1;
+    for (NodeId id : edge_id_) p.offsets[static_cast<std::size_t>(id) + 1] = 2;
+    for (NodeId id : quad_id_) p.offsets[static_cast<std::size_t>(id) + 1] = 4;
+    for (NodeId id : hex_id_) p.offsets[static_cast<std::size_t>(id) + 1] = 8;
+    for (std::size_t i = 0; i < total; ++i) p.offsets[i + 1] += p.offsets[i];
+    p.parents.resize(static_cast<std::size_t>(p.offsets[total]));
+    auto put = [&](NodeId id, auto... nodes) {
+      std::int64_t k = p.offsets[static_cast<std::size_t>(id)];
+      ((p.parents[static_cast<std::size_t>(k++)] = nodes), ...);
+    };
+    for (std::size_t i = 0; i < original_.size(); ++i) put(original_[i], static_cast<NodeId>(i));
     for (std::size_t e = 0; e < edges_.size(); ++e)
-      out[edge_id_[e]] = 0.5 * (x[low(edges_[e])] + x[high(edges_[e])]);
-    // The bilinear centre of a quadrilateral is the mean of its corners, whatever their order.
-    for (std::size_t q = 0; q < quads_.size(); ++q) {
-      Eigen::Vector3d s = Eigen::Vector3d::Zero();
-      for (NodeId n : quads_[q]) s += x[n];
-      out[quad_id_[q]] = 0.25 * s;
+      put(edge_id_[e], low(edges_[e]), high(edges_[e]));
+    for (std::size_t q = 0; q < quads_.size(); ++q)
+      put(quad_id_[q], quads_[q][0], quads_[q][1], quads_[q][2], quads_[q][3]);
+    for (std::size_t h = 0; h < hex_id_.size(); ++h) {
+      const auto& c = mesh_.hexes[h];
+      put(hex_id_[h], c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]);
     }
-    for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) {
-      Eigen::Vector3d s = Eigen::Vector3d::Zero();
-      for (NodeId n : mesh_.hexes[h]) s += x[n];
-      out[hex_id_[h]] = 0.125 * s;
-    }
-    return out;
+    return p;
   }
 
  private:
@@ -236,11 +241,14 @@ void split_hex(const std::array<NodeId, 8>& h, std::size_t index, const NewNodes
 
 }  // namespace
 
-HybridMesh subdivide(const HybridMesh& mesh) {
+HybridMesh subdivide(const HybridMesh& mesh, Prolongation* prolongation) {
   const NewNodes nn(mesh);
+  Prolongation means = nn.prolongation();
   HybridMesh out;
   out.patch_names = mesh.patch_names;
-  out.nodes = nn.coordinates();
+  const std::vector<Eigen::Vector3d> x = means.apply(mesh.nodes);
+  out.nodes.assign(x.begin(), x.end());
+  if (prolongation) *prolongation = std::move(means);
   out.tets.reserve(8 * mesh.tets.size() + 4 * mesh.pyramids.size());
   out.pyramids.reserve(6 * mesh.pyramids.size());
   out.hexes.reserve(8 * mesh.hexes.size());

@@ -113,6 +113,25 @@ TEST(Subdivide, NoisyFieldsWithEveryAmbiguousCaseStayConforming) {
   EXPECT_GT(meshed, 30);
 }
 
+// Every refined node is the mean of one input node, an edge's two, a quadrilateral's four or a
+// hexahedron's eight; prolonging the input's coordinates gives the refined mesh's.
+TEST(Subdivide, ProlongsNodalFieldsAsMeansOfTheParents) {
+  const HybridMesh coarse = cut_ball();
+  Prolongation p;
+  const HybridMesh fine = subdivide(coarse, &p);
+  ASSERT_EQ(p.offsets.size(), fine.nodes.size() + 1);
+  std::size_t by_count[9] = {};
+  for (std::size_t i = 0; i < fine.nodes.size(); ++i) ++by_count[p.offsets[i + 1] - p.offsets[i]];
+  EXPECT_EQ(by_count[1], coarse.nodes.size());
+  EXPECT_EQ(by_count[2] + by_count[4], distinct_edges_and_quads(coarse));
+  EXPECT_EQ(by_count[8], coarse.hexes.size());
+  std::vector<double> height(coarse.nodes.size());
+  for (std::size_t i = 0; i < height.size(); ++i) height[i] = coarse.nodes[i].z();
+  const std::vector<double> prolonged = p.apply(height);
+  for (std::size_t i = 0; i < fine.nodes.size(); ++i)
+    ASSERT_NEAR(prolonged[i], fine.nodes[i].z(), 1e-12) << "node " << i;
+}
+
 // The parent's nodes keep their order and coordinates, and every new node comes after the
 // lowest-numbered parent node it lies between: the mesher's slab order survives refinement.
 TEST(Subdivide, NumbersNewNodesAfterTheirLowestParent) {
