@@ -101,6 +101,11 @@ void add_solve_command(CLI::App& app) {
                   "falls (0: off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_option("--arclength-steps", job.arclength_steps,
+                  "where the continuation in Re stalls at a turning point, follow the steady "
+                  "branch by pseudo-arclength continuation for at most N points (0: stop there)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_flag("!--rebuild-preconditioner", job.picard.reuse_preconditioner,
                 "set the linear solver's preconditioner up anew for every nonlinear step (by "
                 "default it is kept while that saves work)");

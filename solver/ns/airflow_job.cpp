@@ -256,6 +256,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   double reached = 0.0;
   // The method the last converged step needed goes first (pseudo-time from rest).
   bool pseudo_first = true;
+  double resume_arclength = 0.0;  // > 0: the checkpoint was on a branch followed by arclength
   if (resume) {
     last_good = resume->field;
     reached = resume->reynolds;
@@ -264,6 +265,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       // Where the interrupted run stood: the restart takes the path it would have taken.
       step = c.next_step;
       pseudo_first = c.pseudo_time;
+      resume_arclength = c.arclength_step;
       earlier_re = c.earlier_reynolds;
       earlier = std::move(c.earlier);
     } else {
@@ -307,6 +309,193 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   };
   PicardOptions picard = job.picard;
   picard.backflow_patch = outlet;
+  // The inlet→outlet drop of the area-averaged pressure and the largest speed of a field, both
+  // nondimensional (collective).
+  auto pressure_drop = [&](const FlowField& f) {
+    const PatchIntegral in = patch_integral(local, f.pressure, inlet),
+                        out = patch_integral(local, f.pressure, outlet);
+    double sums[4] = {in.integral, in.area, out.integral, out.area};
+    MPI_Allreduce(MPI_IN_PLACE, sums, 4, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+    return sums[0] / sums[1] - sums[2] / sums[3];
+  };
+  auto max_speed = [&](const FlowField& f) {
+    double m = 0.0;
+    for (NodeId k = 0; k < numbering.owned; ++k)
+      m = std::max(m, f.velocity[static_cast<std::size_t>(k)].norm());
+    MPI_Allreduce(MPI_IN_PLACE, &m, 1, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
+    return m;
+  };
+
+  // Pseudo-arclength continuation along the branch through (earlier, earlier_re) and
+  // (last_good, reached), starting with arclength increment `ds` (0: the distance between the
+  // two). Returns true when the branch crossed the target and the target itself converged
+  // (last_good and reached then hold it); otherwise fails, naming what the branch did.
+  // branch.csv records every point — the diagram of Δp against Re that is the evidence.
+  const fs::path branch_csv = job.output / "branch.csv";
+  std::string branch_rows;
+  auto branch_point = [&](double re_point, const FlowField& f, int newton, double s_along) {
+    const double u = r.u_in * re_point / r.reynolds;  // U_in at that Re, m/s
+    branch_rows += fmt::format("{:.6f},{:.6e},{:.6f},{:.6f},{}\n", re_point, s_along,
+                               pressure_drop(f) * job.density * u * u, max_speed(f) * u, newton);
+    if (!writer) return;
+    write_text_file(branch_csv, "reynolds,arclength,pressure_drop_pa,max_speed_m_s,newton_steps\n" +
+                                    branch_rows);
+  };
+  auto follow_branch = [&](double ds) -> bool {
+    log_line(fmt::format("  following the branch through Re {:.2f} and {:.2f} by arclength",
+                         earlier_re, reached));
+    const double re_first = reached;
+    // The secant through the last two points, unit in the constraint's metric.
+    ArclengthConstraint c;
+    auto aim = [&](const FlowField& from, double re_from, const FlowField& to, double re_to) {
+      c.tangent = to;
+      for (std::size_t k = 0; k < to.pressure.size(); ++k) {
+        c.tangent.velocity[k] -= from.velocity[k];
+        c.tangent.pressure[k] -= from.pressure[k];
+      }
+      c.tangent_reynolds = re_to - re_from;
+      const double length =
+          std::sqrt(velocity_inner_product(c.tangent, c.tangent, numbering, PETSC_COMM_WORLD) +
+                    c.tangent_reynolds * c.tangent_reynolds / (re_to * re_to));
+      for (std::size_t k = 0; k < to.pressure.size(); ++k) {
+        c.tangent.velocity[k] /= length;
+        c.tangent.pressure[k] /= length;
+      }
+      c.tangent_reynolds /= length;
+      return length;
+    };
+    const double secant = aim(earlier, earlier_re, last_good, reached);
+    if (!(ds > 0.0)) ds = secant;
+    const double smallest = ds / 64.0;
+    double along = 0.0, lowest = reached, highest = reached;
+    std::vector<double> turns;
+    if (branch_rows.empty()) {
+      branch_point(earlier_re, earlier, 0, -secant);
+      branch_point(reached, last_good, 0, 0.0);
+    }
+    PicardOptions attempt = picard;
+    attempt.pseudo_cfl = 0.0;
+    attempt.max_iterations = std::min(picard.max_iterations, 25);
+    attempt.stall_steps = 5;
+    attempt.tolerance = std::max(picard.tolerance, job.step_tolerance);
+    for (int k = 0; k < job.arclength_steps && ds >= smallest; ++k) {
+      c.origin = last_good;
+      c.origin_reynolds = reached;
+      c.step = ds;
+      FlowField guess = last_good;
+      for (std::size_t i = 0; i < guess.pressure.size(); ++i) {
+        guess.velocity[i] += ds * c.tangent.velocity[i];
+        guess.pressure[i] += ds * c.tangent.pressure[i];
+      }
+      const double re_guess = reached + ds * c.tangent_reynolds;
+      ContinuationStep cs;
+      cs.arclength = true;
+      cs.reynolds = re_guess;
+      Stopwatch clock;
+      PicardReport report;
+      FlowField found;
+      try {
+        found = solve_navier_stokes(local, numbering, 1.0 / re_guess, {}, bc, attempt, &report,
+                                    &guess, &c);
+        cs.converged = report.converged && report.reynolds > 0.0;
+        cs.reynolds = report.reynolds;
+      } catch (const Error& e) {
+        log_line(fmt::format("  arclength step from Re {:.2f}: {}", reached, e.what()));
+      }
+      cs.iterations = report.iterations;
+      cs.linear_iterations = report.linear_iterations;
+      cs.preconditioner_builds = report.preconditioner_builds;
+      cs.residuals = report.residuals;
+      cs.residual = report.residuals.empty() ? NAN : report.residuals.back();
+      cs.seconds = clock.seconds();
+      r.steps.push_back(cs);
+      log_line(
+          fmt::format("  Re {:8.2f}: {} after {} Newton steps on the branch (arclength {:.3g}), "
+                      "residual {:.2e}, {:.1f} s",
+                      cs.reynolds, cs.converged ? "converged" : "FAILED", cs.iterations, ds,
+                      cs.residual, cs.seconds));
+      if (!cs.converged) {
+        ds *= 0.5;
+        continue;
+      }
+      along += ds;
+      const double re_new = cs.reynolds;
+      if (re_new >= r.reynolds) {
+        // Past the target: the target itself, from the chord between the two points.
+        const double t = (r.reynolds - reached) / (re_new - reached);
+        FlowField start = last_good;
+        for (std::size_t i = 0; i < start.pressure.size(); ++i) {
+          start.velocity[i] += t * (found.velocity[i] - last_good.velocity[i]);
+          start.pressure[i] += t * (found.pressure[i] - last_good.pressure[i]);
+        }
+        ContinuationStep last;
+        last.reynolds = r.reynolds;
+        Stopwatch at;
+        PicardReport final_report;
+        PicardOptions exact = attempt;
+        exact.tolerance = picard.tolerance;
+        try {
+          FlowField f = solve_navier_stokes(local, numbering, 1.0 / r.reynolds, {}, bc, exact,
+                                            &final_report, &start);
+          last.converged = final_report.converged;
+          if (last.converged) field = std::move(f);
+        } catch (const Error& e) {
+          log_line(fmt::format("  Re {:.1f}: {}", r.reynolds, e.what()));
+        }
+        last.iterations = final_report.iterations;
+        last.linear_iterations = final_report.linear_iterations;
+        last.preconditioner_builds = final_report.preconditioner_builds;
+        last.residuals = final_report.residuals;
+        last.residual = final_report.residuals.empty() ? NAN : final_report.residuals.back();
+        last.seconds = at.seconds();
+        r.steps.push_back(last);
+        log_line(fmt::format("  Re {:8.1f}: {} after {} Newton steps, residual {:.2e}, {:.1f} s",
+                             r.reynolds, last.converged ? "converged" : "FAILED", last.iterations,
+                             last.residual, last.seconds));
+        if (last.converged) {
+          earlier = std::move(last_good);
+          earlier_re = reached;
+          last_good = field;
+          reached = r.reynolds;
+          branch_point(reached, last_good, last.iterations, along - (1.0 - t) * ds);
+          return true;
+        }
+        ds *= 0.5;  // closer to the target next time
+        continue;
+      }
+      // The branch turns where Re, along it, stops growing (or falling).
+      const double previous_direction = c.tangent_reynolds;
+      earlier = std::move(last_good);
+      earlier_re = reached;
+      last_good = std::move(found);
+      reached = re_new;
+      aim(earlier, earlier_re, last_good, reached);
+      if (previous_direction * c.tangent_reynolds < 0.0) {
+        turns.push_back(earlier_re);
+        log_line(
+            fmt::format("  the branch turns back near Re {:.2f} (a turning point)", earlier_re));
+      }
+      lowest = std::min(lowest, reached);
+      highest = std::max(highest, reached);
+      branch_point(reached, last_good, cs.iterations, along);
+      if (cs.iterations < attempt.max_iterations / 3) ds *= 1.5;
+      SolutionState state = state_at(reached);  // collective
+      state.continuation.next_step = ds;
+      state.continuation.arclength_step = ds;
+      state.continuation.earlier_reynolds = earlier_re;
+      state.continuation.earlier = gather_field(earlier, numbering, PETSC_COMM_WORLD, 0);
+      if (writer) write_solution_h5(state, checkpoint);
+    }
+    if (writer) write_residual_history();
+    const std::string turned =
+        turns.empty() ? std::string("no turning point found")
+                      : fmt::format("it turns back at Re {:.2f}", fmt::join(turns, ", "));
+    fail(
+        "the continuation stalled at Re {:.1f} (target {:.1f}); following the steady branch "
+        "from there by arclength, {}, and it stayed between Re {:.1f} and {:.1f} ({} holds it, "
+        "{} its last point)",
+        re_first, r.reynolds, turned, lowest, highest, branch_csv.string(), checkpoint.string());
+  };
   // With pseudo-time available, each Re is tried with both methods before the increment is
   // halved: Newton alone (on a short budget) and with pseudo-time, first the one that took the
   // last step. Newton from the last solution follows the steady branch even where that branch
@@ -319,6 +508,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   // steps and 112 s; pseudo-time took 14 steps and 119 s).
   const bool pseudo_available = job.picard.pseudo_cfl > 0.0;
   bool retry = false;  // the second try at this Re, with the other method
+  if (resume_arclength > 0.0) follow_branch(resume_arclength);
   for (int s = 0; s < job.max_steps && reached < r.reynolds; ++s) {
     ContinuationStep cs;
     cs.reynolds = re;
@@ -401,6 +591,9 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
         re = reached + step;
       }
       if (step < 1e-3 * r.reynolds) {
+        // A stall after Newton steps on one branch: follow the branch instead.
+        const bool bordered = picard.newton && picard.scheme == PicardOptions::Scheme::coupled;
+        if (job.arclength_steps > 0 && bordered && earlier_re > 0.0 && follow_branch(0.0)) break;
         if (writer) write_residual_history();
         fail("the continuation stalled at Re {:.1f} (target {:.1f}): the step fell below {:.2f}{}",
              reached, r.reynolds, 1e-3 * r.reynolds,
@@ -421,18 +614,13 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   r.flow_ml_s = u * r.inlet_area_mm2;  // m/s × mm² = 1e-6 m³/s = mL/s
   // Each rank's faces and nodes, summed over the ranks.
   {
-    const PatchIntegral in = patch_integral(local, last_good.pressure, inlet),
-                        out = patch_integral(local, last_good.pressure, outlet);
-    double sums[5] = {patch_flux(local, last_good.velocity, outlet), in.integral, in.area,
-                      out.integral, out.area};
-    MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
-    r.outlet_flow_ml_s = sums[0] * u * r.d_in_mm * r.d_in_mm;
-    r.pressure_drop_pa = (sums[1] / sums[2] - sums[3] / sums[4]) * pscale;
+    double flux = patch_flux(local, last_good.velocity, outlet);
+    MPI_Allreduce(MPI_IN_PLACE, &flux, 1, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+    r.outlet_flow_ml_s = flux * u * r.d_in_mm * r.d_in_mm;
   }
+  r.pressure_drop_pa = pressure_drop(last_good) * pscale;
   r.resistance = r.pressure_drop_pa / r.flow_ml_s;
-  for (NodeId k = 0; k < numbering.owned; ++k)
-    r.max_speed = std::max(r.max_speed, last_good.velocity[static_cast<std::size_t>(k)].norm() * u);
-  MPI_Allreduce(MPI_IN_PLACE, &r.max_speed, 1, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
+  r.max_speed = max_speed(last_good) * u;
 
   // Stresses on the boundary, while the geometry is still nondimensional.
   WallStress stress = wall_stress(local, last_good, reached);
@@ -538,11 +726,12 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     std::string steps;
     for (const auto& s : r.steps)
       steps += fmt::format(
-          "{}{{\"reynolds\": {:.6g}, \"converged\": {}, \"nonlinear_iterations\": {}, "
-          "\"linear_iterations\": {}, \"preconditioner_builds\": {}, \"residual\": {:.6e}, "
-          "\"seconds\": {:.3f}}}",
-          steps.empty() ? "" : ", ", s.reynolds, s.converged ? "true" : "false", s.iterations,
-          s.linear_iterations, s.preconditioner_builds, s.residual, s.seconds);
+          "{}{{\"reynolds\": {:.6g}, \"converged\": {}, \"arclength\": {}, "
+          "\"nonlinear_iterations\": {}, \"linear_iterations\": {}, \"preconditioner_builds\": "
+          "{}, \"residual\": {:.6e}, \"seconds\": {:.3f}}}",
+          steps.empty() ? "" : ", ", s.reynolds, s.converged ? "true" : "false",
+          s.arclength ? "true" : "false", s.iterations, s.linear_iterations,
+          s.preconditioner_builds, s.residual, s.seconds);
     std::string patches;
     for (const auto& p : r.patches)
       patches += fmt::format(

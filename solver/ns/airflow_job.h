@@ -30,14 +30,21 @@ struct AirflowJob {
   // on one rank where 1e-5 took 95, but on two ranks its Re 237.5 step diverged (residual
   // 1e33) and the continuation took 154 steps where 1e-5 took 99; 1e-3 took 111 on one rank.
   double step_tolerance = 1e-5;
+  // Where the continuation in Re stalls with two Newton-converged steps behind it — the
+  // steady branch turns back, and no solution lies just beyond in Re — it follows the branch
+  // by pseudo-arclength continuation (navier_stokes.h) for at most this many points (0: fail
+  // there), either around the turning point to the target or far enough to show that the
+  // branch does not reach it.
+  int arclength_steps = 30;
   PicardOptions picard;  // per step
   // Resume from this checkpoint (a solution file of the same mesh) instead of starting low.
   std::optional<std::filesystem::path> restart;
 };
 
 struct ContinuationStep {
-  double reynolds = 0.0;
+  double reynolds = 0.0;  // of an arclength step: the Re it converged at (or was predicted)
   bool converged = false;
+  bool arclength = false;  // a point of the branch followed past a stall
   int iterations = 0;
   int linear_iterations = 0, preconditioner_builds = 0;
   double residual = 0.0, seconds = 0.0;

@@ -378,13 +378,51 @@ class OseenSystem {
   std::vector<char> fixed_;          // per owned row: fixed by a Dirichlet condition
 };
 
+// ⟨t, v⟩ of the arclength constraint with v a vector of the system (this rank's owned rows).
+double velocity_inner_product(const FlowField& t, Vec v, const parallel::NodeNumbering& numbering,
+                              MPI_Comm comm) {
+  const PetscScalar* x = nullptr;
+  check(VecGetArrayRead(v, &x), "VecGetArrayRead");
+  double sum = 0.0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(numbering.owned); ++i)
+    for (int c = 0; c < 3; ++c) sum += t.velocity[i][c] * x[4 * i + static_cast<std::size_t>(c)];
+  check(VecRestoreArrayRead(v, &x), "VecRestoreArrayRead");
+  MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, comm);
+  return sum / static_cast<double>(numbering.global_nodes);
+}
+
+// N(u, Re) of navier_stokes.h: how far the iterate is off the step's hyperplane.
+double arclength_residual(const ArclengthConstraint& a, const FlowField& u, double reynolds,
+                          const parallel::NodeNumbering& numbering, MPI_Comm comm) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(numbering.owned); ++i)
+    sum += a.tangent.velocity[i].dot(u.velocity[i] - a.origin.velocity[i]);
+  MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, comm);
+  return sum / static_cast<double>(numbering.global_nodes) +
+         a.tangent_reynolds * (reynolds - a.origin_reynolds) /
+             (a.origin_reynolds * a.origin_reynolds) -
+         a.step;
+}
+
 }  // namespace
+
+double velocity_inner_product(const FlowField& a, const FlowField& b,
+                              const parallel::NodeNumbering& numbering, MPI_Comm comm) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(numbering.owned); ++i)
+    sum += a.velocity[i].dot(b.velocity[i]);
+  MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, comm);
+  return sum / static_cast<double>(numbering.global_nodes);
+}
 
 FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumbering& numbering,
                               double nu, const BodyForce& force, const DirichletConditions& bc,
                               const PicardOptions& options, PicardReport* report,
-                              const FlowField* initial) {
+                              const FlowField* initial, const ArclengthConstraint* arclength) {
   if (!(nu > 0.0) || !std::isfinite(nu)) fail("viscosity must be positive and finite (got {})", nu);
+  if (arclength && (!initial || !options.newton || options.pseudo_cfl > 0.0 ||
+                    options.scheme != PicardOptions::Scheme::coupled))
+    fail("internal: an arclength step needs a predicted field and coupled Newton steps");
   if (bc.nodes.size() != bc.values.size())
     fail("Dirichlet conditions: {} nodes but {} values", bc.nodes.size(), bc.values.size());
   const std::size_t n = mesh.nodes.size();
@@ -492,6 +530,9 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
   // solution, where Picard's contraction is the more robust).
   double omega = options.relaxation, previous_norm = INFINITY;
   FlowField previous, target;  // the iterate a step started from, and the solve's answer
+  // With an arclength constraint Re moves with the field (relaxed alike): the Re of the
+  // iterate, of the step's start and of the solve's answer.
+  double reynolds = 1.0 / nu, previous_reynolds = reynolds, target_reynolds = reynolds;
   auto relax = [&] {
     for (std::size_t k = 0; k < n; ++k) {
       field.velocity[k] =
@@ -499,10 +540,21 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
       field.pressure[k] =
           previous.pressure[k] + omega * (target.pressure[k] - previous.pressure[k]);
     }
+    if (arclength) {
+      reynolds = previous_reynolds + omega * (target_reynolds - previous_reynolds);
+      nu = 1.0 / reynolds;
+    }
   };
   const std::vector<double> zeros(rows.size(), 0.0);
   double cfl = INFINITY, eta = tightest_linear_tolerance;  // eta: the linear solve's tolerance
   int solves = 0, decreasing = 0, picard_run = 0;
+  // ∂R/∂Re by a forward difference, and the second solve's answer b, in their own vectors.
+  petsc::Vector sensitivity, sensitivity_solution;
+  if (arclength) {
+    check(VecDuplicate(system.solution(), sensitivity.out()), "VecDuplicate");
+    check(VecDuplicate(system.solution(), sensitivity_solution.out()), "VecDuplicate");
+    picard_run = options.picard_steps;  // the predictor is close: Newton from the first step
+  }
   bool newton_step = false;  // the kind of the last solve
   for (int it = 0; solves <= options.max_iterations + 1 && it < 4 * options.max_iterations + 8;
        ++it) {
@@ -512,6 +564,15 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
     const auto linearization =
         stokes ? Linearization::picard
                : (newton ? Linearization::newton : Linearization::picard_residual);
+    // R at a slightly larger Re first (the assembly below overwrites the matrix): relative
+    // 1e-6, where the difference quotient of a residual smooth in ν is accurate to ~1e-6 and
+    // rounding costs ~1e-10.
+    constexpr double kReynoldsDifference = 1e-6;
+    if (arclength) {
+      system.assemble(field.velocity, field.pressure, 1.0 / (reynolds * (1 + kReynoldsDifference)),
+                      force, Linearization::picard_residual);
+      check(VecCopy(system.residual(), sensitivity), "VecCopy");
+    }
     system.assemble(
         stokes ? std::vector<Eigen::Vector3d>(n, Eigen::Vector3d::Zero()) : field.velocity,
         field.pressure, nu, force, linearization);
@@ -525,6 +586,17 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
       check(VecAssemblyBegin(system.residual()), "VecAssemblyBegin");
       check(VecAssemblyEnd(system.residual()), "VecAssemblyEnd");
       check(VecNorm(system.residual(), NORM_2, &norm), "VecNorm");
+      if (arclength) {
+        // ∂R/∂Re, zero on the fixed rows like R.
+        check(VecAXPBY(sensitivity, -1.0 / (reynolds * kReynoldsDifference),
+                       1.0 / (reynolds * kReynoldsDifference), system.residual()),
+              "VecAXPBY");
+        check(VecSetValues(sensitivity, static_cast<PetscInt>(rows.size()), rows.data(),
+                           zeros.data(), INSERT_VALUES),
+              "VecSetValues");
+        check(VecAssemblyBegin(sensitivity), "VecAssemblyBegin");
+        check(VecAssemblyEnd(sensitivity), "VecAssemblyEnd");
+      }
       // Switched evolution relaxation: the Courant number follows the residual's fall, so the
       // steps turn into Newton's (or Picard's) as the iteration converges — as the square of
       // the ratio (on the neonatal airway from Re 150 to 300 with a fixed linear tolerance, 36
@@ -548,7 +620,12 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
       check(VecNorm(system.rhs(), NORM_2, &load), "VecNorm");
       // Relative to the load (forces and boundary data): an iterate that starts close, as a
       // warm start does, must not be held to a fraction of its own small first residual.
-      if (norm <= options.absolute_tolerance || norm <= options.tolerance * load) {
+      // A damped step leaves part of the (linear) arclength constraint unmet: one step more.
+      const bool on_constraint =
+          !arclength || std::abs(arclength_residual(*arclength, field, reynolds, numbering,
+                                                    comm)) <= 1e-6 * std::abs(arclength->step);
+      if ((norm <= options.absolute_tolerance || norm <= options.tolerance * load) &&
+          on_constraint) {
         r.residuals.push_back(norm);
         r.converged = true;
         break;
@@ -664,12 +741,38 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
                                ? fmt::format(" (after {} with the kept preconditioner)", abandoned)
                                : "");
     }
+    double reynolds_step = 0.0;
+    if (arclength && !stokes) {
+      // The second solve of the bordered step, J b = −∂R/∂Re, with the same preconditioner.
+      check(VecAXPBY(system.rhs(), -1.0, 0.0, sensitivity), "VecAXPBY");
+      check(KSPSetReusePreconditioner(ksp, PETSC_TRUE), "KSPSetReusePreconditioner");
+      check(KSPSetTolerances(ksp, eta, PETSC_DEFAULT, PETSC_DEFAULT, max_linear_iterations),
+            "KSPSetTolerances");
+      check(KSPSolve(ksp, system.rhs(), sensitivity_solution), "KSPSolve");
+      PetscInt its = 0;
+      check(KSPGetIterationNumber(ksp, &its), "KSPGetIterationNumber");
+      check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
+      r.linear_iterations += static_cast<int>(its);
+      linear += fmt::format(" + {} for ∂R/∂Re", its);
+      // δRe from the constraint, which is linear: N + ⟨t, a + δRe b⟩ + t_Re δRe / Re₁² = 0.
+      const double n_now = arclength_residual(*arclength, field, reynolds, numbering, comm);
+      const double ta = velocity_inner_product(arclength->tangent, system.solution(), numbering,
+                                               comm),
+                   tb = velocity_inner_product(arclength->tangent, sensitivity_solution, numbering,
+                                               comm);
+      const double weight = 1.0 / (arclength->origin_reynolds * arclength->origin_reynolds);
+      reynolds_step = -(n_now + ta) / (weight * arclength->tangent_reynolds + tb);
+      check(VecAXPY(system.solution(), reynolds_step, sensitivity_solution), "VecAXPY");
+    }
     check(VecAYPX(system.solution(), 1.0, current), "VecAYPX");
     ++solves;
     if (options.log_iterations && system.rank() == 0)
-      log_line(fmt::format("    {} {:3d}: residual {:.3e}, relaxation {:.3f}, CFL {:.3g}, {}",
-                           newton ? "Newton" : "Picard", solves, stokes ? NAN : previous_norm,
-                           stokes ? 1.0 : omega, stokes ? INFINITY : cfl, linear));
+      log_line(fmt::format(
+          "    {} {:3d}: residual {:.3e}, relaxation {:.3f}, CFL {:.3g}, {}{}",
+          newton ? "Newton" : "Picard", solves, stokes ? NAN : previous_norm, stokes ? 1.0 : omega,
+          stokes ? INFINITY : cfl, linear,
+          arclength ? fmt::format(", Re {:.4f} → {:.4f}", reynolds, reynolds + reynolds_step)
+                    : ""));
     if (reason < 0) fail("the linear solver failed ({})", KSPConvergedReasons[reason]);
     if (stokes) {
       system.gather(system.solution(), field);
@@ -677,6 +780,8 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
       previous = field;
       target = field;
       system.gather(system.solution(), target);
+      previous_reynolds = reynolds;
+      target_reynolds = reynolds + reynolds_step;
       relax();
       ++r.iterations;
       if (!newton) ++picard_run;
@@ -684,6 +789,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
     newton_step = newton;
     stokes = false;
   }
+  r.reynolds = reynolds;
   return field;
 }
 

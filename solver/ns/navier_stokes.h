@@ -76,12 +76,30 @@ struct PicardOptions {
   double backflow_beta = 1.0;
 };
 
+// Pseudo-arclength continuation (Keller 1977): the Reynolds number joins the unknowns, and one
+// equation more fixes how far along the branch's tangent (t_u, t_Re) the solution lies,
+//   N(u, Re) = ⟨t_u, u − u₁⟩ + t_Re (Re − Re₁) / Re₁² − Δs = 0,
+// with ⟨·,·⟩ the mean over the nodes of the velocities' dot product (pressure left out: it
+// follows the velocity) and Re measured relative to Re₁. Where a branch of steady solutions
+// turns back (a turning point, where the Jacobian is singular and no solution lies just beyond
+// in Re) the iteration follows it around, which continuation in Re alone cannot. Newton's step
+// on this bordered system by block elimination: J a = −R and J b = −∂R/∂Re (a difference
+// quotient), then δRe from the constraint, which is linear, and δu = a + δRe b.
+struct ArclengthConstraint {
+  FlowField origin;   // u₁: the last point on the branch, on the piece (nondimensional)
+  FlowField tangent;  // t_u on the piece (its pressure is not used)
+  double origin_reynolds = 0.0;   // Re₁
+  double tangent_reynolds = 0.0;  // t_Re
+  double step = 0.0;              // Δs
+};
+
 struct PicardReport {
   std::vector<double> residuals;  // nonlinear residual 2-norm before each solve, and the last
   int iterations = 0;
   int preconditioner_builds = 0;  // linear solves that set the preconditioner up anew
   int linear_iterations = 0;
   bool converged = false;
+  double reynolds = 0.0;  // with an arclength constraint: the Re of the answer (else 1/ν)
 };
 
 // Solves with viscosity ν (1/Re in nondimensional form) and body force f (may be empty).
@@ -89,10 +107,18 @@ struct PicardReport {
 // Each rank of the communicator passes its piece of the mesh (parallel::mesh_piece; the whole
 // mesh with parallel::whole_numbering on one rank), the conditions and the initial field on
 // that piece, and gets the field on it back.
+// With `arclength` the Reynolds number is an unknown too (Newton steps only, no pseudo-time):
+// ν = 1/Re of the predictor, `initial` the predicted field, and report->reynolds the Re found.
 FlowField solve_navier_stokes(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
                               double nu, const BodyForce& force,
                               const DirichletConditions& conditions, const PicardOptions& options,
-                              PicardReport* report = nullptr, const FlowField* initial = nullptr);
+                              PicardReport* report = nullptr, const FlowField* initial = nullptr,
+                              const ArclengthConstraint* arclength = nullptr);
+
+// ⟨a, b⟩ of the arclength constraint: the mean over the whole mesh's nodes of a_u·b_u, from
+// each rank's owned nodes (the first `numbering.owned` of its piece). Collective.
+double velocity_inner_product(const FlowField& a, const FlowField& b,
+                              const parallel::NodeNumbering& numbering, MPI_Comm comm);
 
 // The same from the whole mesh on every rank: the ranks cut it into pieces, solve, and each
 // gets the whole field back. For tests and small problems.

@@ -136,6 +136,7 @@ void write_solution_h5(const SolutionState& s, const fs::path& path, const MeshC
       attribute(file.get(), "next_step", c.next_step, path);
       attribute(file.get(), "pseudo_time", c.pseudo_time ? 1.0 : 0.0, path);
       attribute(file.get(), "earlier_reynolds", c.earlier_reynolds, path);
+      if (c.arclength_step > 0.0) attribute(file.get(), "arclength_step", c.arclength_step, path);
       if (c.earlier_reynolds > 0.0)
         write_fields(file.get(), "earlier_velocity_nondimensional",
                      "earlier_pressure_nondimensional", c.earlier, 1.0, 1.0, path);
@@ -165,11 +166,22 @@ SolutionState read_solution_h5(const fs::path& path) {
     c.next_step = number_attribute(file.get(), "next_step", path);
     c.pseudo_time = number_attribute(file.get(), "pseudo_time", path) != 0.0;
     c.earlier_reynolds = number_attribute(file.get(), "earlier_reynolds", path);
-    if (!(c.next_step > 0.0) || !(c.earlier_reynolds >= 0.0) || c.earlier_reynolds >= s.reynolds)
+    if (H5Aexists(file.get(), "arclength_step") > 0) {
+      // Around a turning point the branch's earlier point may lie above in Re.
+      c.arclength_step = number_attribute(file.get(), "arclength_step", path);
+      if (!(c.arclength_step > 0.0) || !(c.earlier_reynolds > 0.0) ||
+          c.earlier_reynolds == s.reynolds)
+        fail(
+            "{}: an inconsistent arclength state (step {}, earlier Re {} at Re {}: the step must "
+            "be positive and the earlier point another)",
+            path.string(), c.arclength_step, c.earlier_reynolds, s.reynolds);
+    } else if (!(c.next_step > 0.0) || !(c.earlier_reynolds >= 0.0) ||
+               c.earlier_reynolds >= s.reynolds) {
       fail(
           "{}: an inconsistent continuation state (next step {}, earlier Re {} at Re {}: the "
           "step must be positive and the earlier Re lower)",
           path.string(), c.next_step, c.earlier_reynolds, s.reynolds);
+    }
     if (c.earlier_reynolds > 0.0) {
       c.earlier = read_fields(file.get(), "earlier_velocity_nondimensional",
                               "earlier_pressure_nondimensional", path);

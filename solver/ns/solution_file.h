@@ -16,7 +16,9 @@
 //
 //   /  attributes next_step (the increment of Re to try next), pseudo_time (1: the step
 //      converged with pseudo-time, which the next one tries first), earlier_reynolds (the
-//      converged step before, 0: none)
+//      converged step before, 0: none), arclength_step (present when the run was following
+//      the branch by arclength: the next arclength increment; the earlier step is then the
+//      branch's point before, at any Re but this one)
 //   /earlier_velocity_nondimensional, /earlier_pressure_nondimensional  (earlier_reynolds > 0)
 #include <cstdint>
 #include <filesystem>
@@ -34,6 +36,7 @@ struct ContinuationState {
   bool pseudo_time = false;       // the step converged with pseudo-time
   double earlier_reynolds = 0.0;  // 0: no earlier step for the predictor
   FlowField earlier;              // nondimensional, at earlier_reynolds
+  double arclength_step = 0.0;    // > 0: following the branch by arclength (airflow_job.h)
 };
 
 struct SolutionState {

@@ -527,6 +527,44 @@ TEST_F(Cli, SolvesTheFlowThroughACutBall) {
   EXPECT_NE(text.find("\"inlet_profile\": \"expression 3 + 0*x*r\""), std::string::npos) << text;
 }
 
+// A checkpoint taken while following a branch by arclength resumes on the branch: from the
+// Newton steps at Re 6 and 8 through the cut ball, marked as points of a branch, the run follows
+// it by arclength until Re passes 20, converges at 20 itself — the answer of a run that goes
+// there by Re alone — and lists the points in branch.csv, Re rising along this branch.
+TEST_F(Cli, ResumedBranchIsFollowedByArclengthToTheTarget) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const fs::path mesh = dir_ / "out" / "mesh.h5";
+  ASSERT_EQ(naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string()).status,
+            0);
+  const std::string solve = "solve " + mesh.string() + " --pseudo-cfl 0";
+  const fs::path direct = dir_ / "out" / "direct", low = dir_ / "out" / "low",
+                 branch = dir_ / "out" / "branch";
+  ASSERT_EQ(naris(solve + " --re 20 -o " + direct.string()).status, 0);
+  ASSERT_EQ(naris(solve + " --re 8 --re-start 6 -o " + low.string()).status, 0);
+  naris::ns::SolutionState point = naris::ns::read_solution_h5(low / "checkpoint.h5");
+  ASSERT_EQ(point.continuation.earlier_reynolds, 6.0);
+  point.continuation.arclength_step = 0.25;
+  naris::ns::write_solution_h5(point, dir_ / "branch-point.h5");
+  const CliRun r = naris(solve + " --re 20 --restart " + (dir_ / "branch-point.h5").string() +
+                         " -o " + branch.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("by arclength"), std::string::npos) << r.err;
+  EXPECT_NEAR(summary(branch, "pressure_drop_pa"), summary(direct, "pressure_drop_pa"),
+              1e-5 * summary(direct, "pressure_drop_pa"));
+  EXPECT_NEAR(summary(branch, "max_speed_m_s"), summary(direct, "max_speed_m_s"),
+              1e-5 * summary(direct, "max_speed_m_s"));
+  std::ifstream csv(branch / "branch.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "reynolds,arclength,pressure_drop_pa,max_speed_m_s,newton_steps");
+  std::vector<double> re;
+  while (std::getline(csv, line)) re.push_back(std::stod(line));
+  ASSERT_GE(re.size(), 4u);  // the two given points, one on the branch at least, the target
+  EXPECT_EQ(re.front(), 6.0);
+  EXPECT_EQ(re.back(), 20.0);
+  EXPECT_TRUE(std::is_sorted(re.begin(), re.end()));
+}
+
 // A run stopped after two continuation steps and resumed from its checkpoint takes the steps
 // the uninterrupted run took: the same Re, method and residuals (the checkpoint keeps the
 // next increment, the method and the earlier step of the secant predictor) — with pseudo-time
@@ -693,6 +731,13 @@ TEST_F(Cli, SolveBadInput) {
   expect_clean_failure(
       naris("solve " + cut.string() + " --restart " + (dir_ / "in" / "odd.h5").string() + o),
       "inconsistent continuation state");
+  // Following a branch the earlier point may lie above in Re, but it must be another point.
+  odd.continuation.arclength_step = 0.1;
+  odd.continuation.earlier_reynolds = odd.reynolds;
+  naris::ns::write_solution_h5(odd, dir_ / "in" / "odd.h5");
+  expect_clean_failure(
+      naris("solve " + cut.string() + " --restart " + (dir_ / "in" / "odd.h5").string() + o),
+      "inconsistent arclength state");
   const CliRun r = naris("solve " + cut.string() +
                          " --re 400 --max-iterations 1 --step-tolerance 1e-8 --restart " +
                          (good / "checkpoint.h5").string() + " -o " + good.string());

@@ -233,6 +233,81 @@ TEST(NavierStokes, AssemblyIsAnEventOfPetscsProfile) {
   EXPECT_EQ(count("NSWholeDerivative") - derivatives, report.iterations - o.picard_steps);
 }
 
+// A pseudo-arclength step lands on the branch of steady solutions: from the solutions at Re 80
+// and 90 (Beltrami data, the body force held fixed, so R(u, Re) is one smooth family) along
+// their secant by its own length, forwards and backwards, it finds a point that satisfies the
+// arclength constraint and is the solution that continuation in Re finds at the Re it reports.
+TEST(NavierStokes, ArclengthStepFindsTheSolutionAtTheReItReports) {
+  const BeltramiBall problem;
+  const auto& [nu, force, mesh, bc] = problem;
+  const parallel::NodeNumbering whole = parallel::whole_numbering(mesh.nodes.size());
+  PicardOptions o;
+  o.tolerance = 1e-11;
+  o.linear_tolerance = o.loosest_linear_tolerance = 1e-10;
+  const FlowField u80 = solve_navier_stokes(mesh, whole, 1.0 / 80, force, bc, o);
+  const FlowField u90 = solve_navier_stokes(mesh, whole, 1.0 / 90, force, bc, o, nullptr, &u80);
+  for (const bool forwards : {true, false}) {
+    const FlowField& from = forwards ? u80 : u90;
+    const FlowField& to = forwards ? u90 : u80;
+    const double re_from = forwards ? 80 : 90, re_to = forwards ? 90 : 80;
+    ArclengthConstraint c;
+    c.origin = to;
+    c.origin_reynolds = re_to;
+    c.tangent = to;
+    for (std::size_t k = 0; k < to.pressure.size(); ++k) {
+      c.tangent.velocity[k] -= from.velocity[k];
+      c.tangent.pressure[k] -= from.pressure[k];
+    }
+    c.tangent_reynolds = re_to - re_from;
+    const double length =
+        std::sqrt(velocity_inner_product(c.tangent, c.tangent, whole, PETSC_COMM_WORLD) +
+                  std::pow(c.tangent_reynolds / re_to, 2));
+    for (std::size_t k = 0; k < to.pressure.size(); ++k) {
+      c.tangent.velocity[k] /= length;
+      c.tangent.pressure[k] /= length;
+    }
+    c.tangent_reynolds /= length;
+    c.step = length;
+    FlowField guess = to;
+    for (std::size_t k = 0; k < guess.pressure.size(); ++k) {
+      guess.velocity[k] += c.step * c.tangent.velocity[k];
+      guess.pressure[k] += c.step * c.tangent.pressure[k];
+    }
+    // The predictor's Re, 3 too far: the corrector has to bring Re back to the hyperplane.
+    const double re_guess = re_to + c.step * c.tangent_reynolds;
+    const double re_start = re_guess + (forwards ? 3.0 : -3.0);
+    PicardReport report;
+    const FlowField found =
+        solve_navier_stokes(mesh, whole, 1.0 / re_start, force, bc, o, &report, &guess, &c);
+    ASSERT_TRUE(report.converged) << (forwards ? "forwards" : "backwards");
+    std::printf(
+        "[ info ] arclength %s: predicted Re %.4f, started at %.4f, found Re %.4f in %d Newton "
+        "steps\n",
+        forwards ? "forwards" : "backwards", re_guess, re_start, report.reynolds,
+        report.iterations);
+    EXPECT_LT(std::abs(report.reynolds - re_guess), 1.0);
+    // It moved along the branch by about the secant's length, in the tangent's direction.
+    EXPECT_GT((report.reynolds - re_to) * c.tangent_reynolds, 0.0);
+    EXPECT_NEAR(std::abs(report.reynolds - re_to), 10.0, 2.0);
+    // On the hyperplane of the constraint …
+    FlowField moved = found;
+    for (std::size_t k = 0; k < moved.pressure.size(); ++k) moved.velocity[k] -= to.velocity[k];
+    const double constraint = velocity_inner_product(c.tangent, moved, whole, PETSC_COMM_WORLD) +
+                              c.tangent_reynolds * (report.reynolds - re_to) / (re_to * re_to) -
+                              c.step;
+    EXPECT_LT(std::abs(constraint), 1e-6 * c.step);
+    // … and the solution at that Re.
+    const FlowField direct =
+        solve_navier_stokes(mesh, whole, 1.0 / report.reynolds, force, bc, o, nullptr, &to);
+    double du = 0.0, scale = 0.0;
+    for (std::size_t k = 0; k < mesh.nodes.size(); ++k) {
+      du = std::max(du, (found.velocity[k] - direct.velocity[k]).norm());
+      scale = std::max(scale, direct.velocity[k].norm());
+    }
+    EXPECT_LT(du, 1e-7 * scale) << (forwards ? "forwards" : "backwards");
+  }
+}
+
 // An iteration that crawls — here Picard held to 5 % steps, so the residual falls a few
 // percent a step — is given up once it has not halved over `stall_steps` steps, long before
 // max_iterations; left alone it would go on.
