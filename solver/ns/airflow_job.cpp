@@ -155,6 +155,16 @@ std::vector<Eigen::Vector3d> gather_face_shear(const std::vector<Eigen::Vector3d
   return whole;
 }
 
+// a + t (b − a), node by node: the secant predictor (t beyond 1) and the chord (t in [0, 1]).
+FlowField blend(const FlowField& a, const FlowField& b, double t) {
+  FlowField out = a;
+  for (std::size_t k = 0; k < out.pressure.size(); ++k) {
+    out.velocity[k] += t * (b.velocity[k] - a.velocity[k]);
+    out.pressure[k] += t * (b.pressure[k] - a.pressure[k]);
+  }
+  return out;
+}
+
 }  // namespace
 
 AirflowResult run_airflow_job(const AirflowJob& job) {
@@ -341,6 +351,44 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     write_text_file(branch_csv, "reynolds,arclength,pressure_drop_pa,max_speed_m_s,newton_steps\n" +
                                     branch_rows);
   };
+  // A solve's counts into its continuation step, which joins the history.
+  auto record = [&](ContinuationStep& cs, const PicardReport& report, const Stopwatch& clock) {
+    cs.iterations = report.iterations;
+    cs.linear_iterations = report.linear_iterations;
+    cs.preconditioner_builds = report.preconditioner_builds;
+    cs.residuals = report.residuals;
+    cs.residual = report.residuals.empty() ? NAN : report.residuals.back();
+    cs.seconds = clock.seconds();
+    r.steps.push_back(cs);
+  };
+  auto point_below = [&] {
+    const double re_below = 0.99 * reached;
+    PicardOptions attempt = picard;
+    attempt.pseudo_cfl = 0.0;
+    attempt.max_iterations = std::min(picard.max_iterations, 25);
+    attempt.stall_steps = 5;
+    attempt.tolerance = std::max(picard.tolerance, job.step_tolerance);
+    ContinuationStep cs;
+    cs.reynolds = re_below;
+    Stopwatch clock;
+    PicardReport report;
+    FlowField below;
+    try {
+      below = solve_navier_stokes(local, numbering, 1.0 / re_below, {}, bc, attempt, &report,
+                                  &last_good);
+      cs.converged = report.converged;
+    } catch (const Error& e) {
+      log_line(fmt::format("  Re {:.1f}: {}", re_below, e.what()));
+    }
+    record(cs, report, clock);
+    log_line(fmt::format(
+        "  Re {:8.2f}: {} after {} Newton steps (a second point of the branch, "
+        "for its tangent), residual {:.2e}, {:.1f} s",
+        re_below, cs.converged ? "converged" : "FAILED", cs.iterations, cs.residual, cs.seconds));
+    if (!cs.converged) return;
+    earlier = std::move(below);
+    earlier_re = re_below;
+  };
   auto follow_branch = [&](double ds) -> bool {
     log_line(fmt::format("  following the branch through Re {:.2f} and {:.2f} by arclength",
                          earlier_re, reached));
@@ -402,13 +450,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       } catch (const Error& e) {
         log_line(fmt::format("  arclength step from Re {:.2f}: {}", reached, e.what()));
       }
-      cs.iterations = report.iterations;
-      cs.linear_iterations = report.linear_iterations;
-      cs.preconditioner_builds = report.preconditioner_builds;
-      cs.residuals = report.residuals;
-      cs.residual = report.residuals.empty() ? NAN : report.residuals.back();
-      cs.seconds = clock.seconds();
-      r.steps.push_back(cs);
+      record(cs, report, clock);
       log_line(
           fmt::format("  Re {:8.2f}: {} after {} Newton steps on the branch (arclength {:.3g}), "
                       "residual {:.2e}, {:.1f} s",
@@ -423,11 +465,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       if (re_new >= r.reynolds) {
         // Past the target: the target itself, from the chord between the two points.
         const double t = (r.reynolds - reached) / (re_new - reached);
-        FlowField start = last_good;
-        for (std::size_t i = 0; i < start.pressure.size(); ++i) {
-          start.velocity[i] += t * (found.velocity[i] - last_good.velocity[i]);
-          start.pressure[i] += t * (found.pressure[i] - last_good.pressure[i]);
-        }
+        const FlowField start = blend(last_good, found, t);
         ContinuationStep last;
         last.reynolds = r.reynolds;
         Stopwatch at;
@@ -442,13 +480,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
         } catch (const Error& e) {
           log_line(fmt::format("  Re {:.1f}: {}", r.reynolds, e.what()));
         }
-        last.iterations = final_report.iterations;
-        last.linear_iterations = final_report.linear_iterations;
-        last.preconditioner_builds = final_report.preconditioner_builds;
-        last.residuals = final_report.residuals;
-        last.residual = final_report.residuals.empty() ? NAN : final_report.residuals.back();
-        last.seconds = at.seconds();
-        r.steps.push_back(last);
+        record(last, final_report, at);
         log_line(fmt::format("  Re {:8.1f}: {} after {} Newton steps, residual {:.2e}, {:.1f} s",
                              r.reynolds, last.converged ? "converged" : "FAILED", last.iterations,
                              last.residual, last.seconds));
@@ -532,11 +564,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     const bool predict = earlier_re > 0.0 && !retry;
     if (predict) {
       const double t = (1.0 / re - 1.0 / reached) / (1.0 / reached - 1.0 / earlier_re);
-      predicted = last_good;
-      for (std::size_t k = 0; k < predicted.pressure.size(); ++k) {
-        predicted.velocity[k] += t * (last_good.velocity[k] - earlier.velocity[k]);
-        predicted.pressure[k] += t * (last_good.pressure[k] - earlier.pressure[k]);
-      }
+      predicted = blend(earlier, last_good, 1.0 + t);
     }
     try {
       field = solve_navier_stokes(local, numbering, 1.0 / re, {}, bc, attempt, &report,
@@ -548,13 +576,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       cs.converged = false;  // a diverged iteration: treated as a failed step
       log_line(fmt::format("  Re {:.1f}: {}", re, e.what()));
     }
-    cs.iterations = report.iterations;
-    cs.linear_iterations = report.linear_iterations;
-    cs.preconditioner_builds = report.preconditioner_builds;
-    cs.residuals = report.residuals;
-    cs.residual = report.residuals.empty() ? NAN : report.residuals.back();
-    cs.seconds = clock.seconds();
-    r.steps.push_back(cs);
+    record(cs, report, clock);
     log_line(fmt::format("  Re {:8.1f}: {} after {} nonlinear steps{}, residual {:.2e}, {:.1f} s",
                          re, cs.converged ? "converged" : "FAILED", cs.iterations,
                          pseudo ? " with pseudo-time" : "", cs.residual, cs.seconds));
@@ -593,7 +615,12 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       if (step < 1e-3 * r.reynolds) {
         // A stall after Newton steps on one branch: follow the branch instead.
         const bool bordered = picard.newton && picard.scheme == PicardOptions::Scheme::coupled;
-        if (job.arclength_steps > 0 && bordered && earlier_re > 0.0 && follow_branch(0.0)) break;
+        if (job.arclength_steps > 0 && bordered) {
+          // After pseudo-time steps there is one point only: the second of the secant by a
+          // Newton step back from it, which stays on its branch.
+          if (!(earlier_re > 0.0)) point_below();
+          if (earlier_re > 0.0 && follow_branch(0.0)) break;
+        }
         if (writer) write_residual_history();
         fail("the continuation stalled at Re {:.1f} (target {:.1f}): the step fell below {:.2f}{}",
              reached, r.reynolds, 1e-3 * r.reynolds,
