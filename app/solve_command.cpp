@@ -15,7 +15,7 @@ void add_solve_command(CLI::App& app) {
   struct Options {
     ns::AirflowJob job;
     std::string profile = "uniform", petsc_options, scheme = "coupled";
-    std::filesystem::path restart;
+    std::filesystem::path restart, restart_mesh;
     bool verbose = false;
     double inlet_speed = 0.0;
   };
@@ -113,9 +113,16 @@ void add_solve_command(CLI::App& app) {
                   "largest step fraction (0, 1]; the step is cut back while the residual grows")
       ->check(CLI::Range(0.01, 1.0))
       ->capture_default_str();
-  cmd->add_option("--restart", o->restart,
-                  "resume the continuation from a checkpoint (the -o folder's checkpoint.h5 is "
-                  "rewritten after every converged step)");
+  auto* restart =
+      cmd->add_option("--restart", o->restart,
+                      "resume the continuation from a checkpoint (the -o folder's checkpoint.h5 is "
+                      "rewritten after every converged step)");
+  auto* restart_mesh =
+      cmd->add_option("--restart-mesh", o->restart_mesh,
+                      "the mesh the --restart file belongs to, when the mesh solved is that mesh "
+                      "subdivided (naris mesh --subdivide): its field is prolonged onto this one "
+                      "and may be at the target Re itself");
+  restart_mesh->needs(restart);
   cmd->add_flag("--verbose", o->verbose, "a line per nonlinear (Picard or Newton) step");
   cmd->add_option("--petsc", o->petsc_options,
                   "PETSc options for the linear solves (prefix ns_), e.g. \"-ns_ksp_monitor\"");
@@ -136,6 +143,7 @@ void add_solve_command(CLI::App& app) {
     }
     if (o->inlet_speed != 0.0) o->job.inlet_speed = o->inlet_speed;
     if (!o->restart.empty()) o->job.restart = o->restart;
+    if (!o->restart_mesh.empty()) o->job.restart_mesh = o->restart_mesh;
     o->job.picard.log_iterations = o->verbose;
     if (o->scheme == "segregated-gmres")
       o->job.picard.scheme = ns::PicardOptions::Scheme::segregated_krylov;

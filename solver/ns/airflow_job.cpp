@@ -18,6 +18,7 @@
 #include "parallel/partition.h"
 #include "patches/patches.h"
 #include "quality/check.h"
+#include "refine/subdivide.h"
 
 namespace naris::ns {
 namespace fs = std::filesystem;
@@ -155,6 +156,32 @@ std::vector<Eigen::Vector3d> gather_face_shear(const std::vector<Eigen::Vector3d
   return whole;
 }
 
+// A solution on the mesh `coarse_file` prolonged onto the mesh of `fingerprint`, which must be
+// that mesh subdivided one to three times.
+void prolong_solution(SolutionState& s, const fs::path& restart, const fs::path& coarse_file,
+                      const fs::path& mesh_file, std::uint64_t fingerprint, std::size_t nodes) {
+  HybridMesh coarse = read_mesh_h5(coarse_file);
+  if (mesh_fingerprint(coarse) != s.mesh_fingerprint)
+    fail("{}: the checkpoint belongs to another mesh than {}", restart.string(),
+         coarse_file.string());
+  std::vector<Prolongation> levels;
+  while (coarse.nodes.size() < nodes && levels.size() < 3) {
+    levels.emplace_back();
+    coarse = subdivide(coarse, &levels.back());
+  }
+  if (mesh_fingerprint(coarse) != fingerprint)
+    fail(
+        "{} is not {} subdivided: mesh both from the same image and settings, the finer with "
+        "--subdivide",
+        mesh_file.string(), coarse_file.string());
+  for (const Prolongation& p : levels) {
+    s.field.velocity = p.apply(s.field.velocity);
+    s.field.pressure = p.apply(s.field.pressure);
+  }
+  s.mesh_fingerprint = fingerprint;
+  s.continuation = {};  // the coarse mesh's path does not carry over
+}
+
 // a + t (b − a), node by node: the secant predictor (t beyond 1) and the chord (t in [0, 1]).
 FlowField blend(const FlowField& a, const FlowField& b, double t) {
   FlowField out = a;
@@ -210,6 +237,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   std::optional<SolutionState> resume;
   if (job.restart) {
     resume = read_solution_h5(*job.restart);
+    if (job.restart_mesh)
+      prolong_solution(*resume, *job.restart, *job.restart_mesh, job.mesh, fingerprint, r.nodes);
     if (resume->mesh_fingerprint != fingerprint || resume->field.pressure.size() != r.nodes)
       fail("{}: the checkpoint belongs to another mesh than {} ({} nodes vs {})",
            job.restart->string(), job.mesh.string(), resume->field.pressure.size(), r.nodes);
@@ -217,7 +246,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       fail("{}: the checkpoint was scaled with d_in {} mm, this mesh has {} mm",
            job.restart->string(), resume->d_in_mm, r.d_in_mm);
     r.restarted_from = resume->reynolds;
-    if (resume->reynolds >= r.reynolds)
+    const bool at_target = job.restart_mesh && resume->reynolds == r.reynolds;
+    if (resume->reynolds >= r.reynolds && !at_target)
       fail("{}: the checkpoint is at Re {:.1f}, at or past the target {:.1f}: nothing to continue",
            job.restart->string(), resume->reynolds, r.reynolds);
   }
@@ -286,7 +316,15 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       pseudo_first = false;
     }
     re = std::min(r.reynolds, reached + step);
-    log_line(fmt::format("  restarting from Re {:.1f} ({}), next Re {:.1f}", reached,
+    if (reached >= r.reynolds) {
+      // A prolonged field at the target: the target's step starts from it, Newton first.
+      re = step = r.reynolds;
+      reached = 0.0;
+    }
+    if (job.restart_mesh)
+      log_line(fmt::format("  the solution at Re {:.1f} on {} prolonged onto this mesh",
+                           resume->reynolds, job.restart_mesh->string()));
+    log_line(fmt::format("  restarting from Re {:.1f} ({}), next Re {:.1f}", resume->reynolds,
                          job.restart->string(), re));
   }
   const fs::path checkpoint = job.output / "checkpoint.h5";
@@ -568,9 +606,9 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     }
     try {
       field = solve_navier_stokes(local, numbering, 1.0 / re, {}, bc, attempt, &report,
-                                  predict         ? &predicted
-                                  : reached > 0.0 ? &last_good
-                                                  : nullptr);
+                                  predict                       ? &predicted
+                                  : !last_good.pressure.empty() ? &last_good
+                                                                : nullptr);
       cs.converged = report.converged;
     } catch (const Error& e) {
       cs.converged = false;  // a diverged iteration: treated as a failed step

@@ -39,6 +39,11 @@ struct AirflowJob {
   PicardOptions picard;  // per step
   // Resume from this checkpoint (a solution file of the same mesh) instead of starting low.
   std::optional<std::filesystem::path> restart;
+  // The mesh `restart` was computed on, when `mesh` is that mesh subdivided (naris mesh
+  // --subdivide): the field is prolonged onto this mesh (the parent's interpolant at every new
+  // node), and a checkpoint at the target itself is the start of the target's step — a
+  // mesh-convergence study warm-started from the coarser mesh.
+  std::optional<std::filesystem::path> restart_mesh;
 };
 
 struct ContinuationStep {

@@ -565,6 +565,40 @@ TEST_F(Cli, ResumedBranchIsFollowedByArclengthToTheTarget) {
   EXPECT_TRUE(std::is_sorted(re.begin(), re.end()));
 }
 
+// A solution on a mesh starts the solve on that mesh subdivided: prolonged onto it, at the
+// target itself, it converges to the answer of a run from rest on the finer mesh. A checkpoint
+// of a mesh the finer one does not subdivide is refused.
+TEST_F(Cli, RestartOnTheSubdividedMeshProlongsTheCoarseSolution) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const fs::path coarse = dir_ / "coarse" / "mesh.h5", fine = dir_ / "fine" / "mesh.h5",
+                 other = dir_ / "other" / "mesh.h5";
+  const std::string cuts = " --inlet k=3 --outlet k=8";
+  ASSERT_EQ(naris("mesh " + in.string() + cuts + " -o " + coarse.string()).status, 0);
+  ASSERT_EQ(naris("mesh " + in.string() + cuts + " --subdivide 1 -o " + fine.string()).status, 0);
+  ASSERT_EQ(naris("mesh " + in.string() + " --inlet k=3 --outlet k=7 -o " + other.string()).status,
+            0);
+  const fs::path low = dir_ / "low", other_low = dir_ / "other-low", direct = dir_ / "direct",
+                 prolonged = dir_ / "prolonged";
+  ASSERT_EQ(naris("solve " + coarse.string() + " --re 8 -o " + low.string()).status, 0);
+  ASSERT_EQ(naris("solve " + fine.string() + " --re 8 -o " + direct.string()).status, 0);
+  const CliRun r =
+      naris("solve " + fine.string() + " --re 8 --restart " + (low / "checkpoint.h5").string() +
+            " --restart-mesh " + coarse.string() + " -o " + prolonged.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("prolonged onto this mesh"), std::string::npos) << r.err;
+  EXPECT_NEAR(summary(prolonged, "pressure_drop_pa"), summary(direct, "pressure_drop_pa"),
+              1e-5 * summary(direct, "pressure_drop_pa"));
+  ASSERT_EQ(naris("solve " + other.string() + " --re 8 -o " + other_low.string()).status, 0);
+  expect_clean_failure(naris("solve " + fine.string() + " --re 8 --restart " +
+                             (other_low / "checkpoint.h5").string() + " --restart-mesh " +
+                             other.string() + " " + out()),
+                       "is not");
+  expect_clean_failure(
+      naris("solve " + fine.string() + " --re 8 --restart " + (low / "checkpoint.h5").string() +
+            " --restart-mesh " + other.string() + " " + out()),
+      "belongs to another mesh");
+}
+
 // A run stopped after two continuation steps and resumed from its checkpoint takes the steps
 // the uninterrupted run took: the same Re, method and residuals (the checkpoint keeps the
 // next increment, the method and the earlier step of the secant predictor) — with pseudo-time
