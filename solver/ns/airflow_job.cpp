@@ -389,8 +389,23 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     write_text_file(branch_csv, "reynolds,arclength,pressure_drop_pa,max_speed_m_s,newton_steps\n" +
                                     branch_rows);
   };
-  // A solve's counts into its continuation step, which joins the history.
-  auto record = [&](ContinuationStep& cs, const PicardReport& report, const Stopwatch& clock) {
+  // One solve of the continuation at Re `re_solve` (with `constraint`: its predictor's), its
+  // counts into `cs`, which joins the history. A diverged iteration is a failed try; the field
+  // is then empty.
+  auto solve_step = [&](ContinuationStep& cs, double re_solve, const PicardOptions& options,
+                        const FlowField* initial, const ArclengthConstraint* constraint) {
+    Stopwatch clock;
+    PicardReport report;
+    FlowField f;
+    try {
+      f = solve_navier_stokes(local, numbering, 1.0 / re_solve, {}, bc, options, &report, initial,
+                              constraint);
+      cs.converged = report.converged && (!constraint || report.reynolds > 0.0);
+      if (constraint) cs.reynolds = report.reynolds;
+    } catch (const Error& e) {
+      cs.converged = false;
+      log_line(fmt::format("  Re {:.1f}: {}", re_solve, e.what()));
+    }
     cs.iterations = report.iterations;
     cs.linear_iterations = report.linear_iterations;
     cs.preconditioner_builds = report.preconditioner_builds;
@@ -398,27 +413,23 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     cs.residual = report.residuals.empty() ? NAN : report.residuals.back();
     cs.seconds = clock.seconds();
     r.steps.push_back(cs);
+    return f;
   };
-  auto point_below = [&] {
-    const double re_below = 0.99 * reached;
+  // Newton alone on a short budget, to the steps' tolerance: the points of the branch.
+  auto newton_only = [&] {
     PicardOptions attempt = picard;
     attempt.pseudo_cfl = 0.0;
     attempt.max_iterations = std::min(picard.max_iterations, 25);
     attempt.stall_steps = 5;
     attempt.tolerance = std::max(picard.tolerance, job.step_tolerance);
+    return attempt;
+  };
+  auto point_below = [&] {
+    const double re_below = 0.99 * reached;
+    const PicardOptions attempt = newton_only();
     ContinuationStep cs;
     cs.reynolds = re_below;
-    Stopwatch clock;
-    PicardReport report;
-    FlowField below;
-    try {
-      below = solve_navier_stokes(local, numbering, 1.0 / re_below, {}, bc, attempt, &report,
-                                  &last_good);
-      cs.converged = report.converged;
-    } catch (const Error& e) {
-      log_line(fmt::format("  Re {:.1f}: {}", re_below, e.what()));
-    }
-    record(cs, report, clock);
+    FlowField below = solve_step(cs, re_below, attempt, &last_good, nullptr);
     log_line(fmt::format(
         "  Re {:8.2f}: {} after {} Newton steps (a second point of the branch, "
         "for its tangent), residual {:.2e}, {:.1f} s",
@@ -434,21 +445,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     // The secant through the last two points, unit in the constraint's metric.
     ArclengthConstraint c;
     auto aim = [&](const FlowField& from, double re_from, const FlowField& to, double re_to) {
-      c.tangent = to;
-      for (std::size_t k = 0; k < to.pressure.size(); ++k) {
-        c.tangent.velocity[k] -= from.velocity[k];
-        c.tangent.pressure[k] -= from.pressure[k];
-      }
-      c.tangent_reynolds = re_to - re_from;
-      const double length =
-          std::sqrt(velocity_inner_product(c.tangent, c.tangent, numbering, PETSC_COMM_WORLD) +
-                    c.tangent_reynolds * c.tangent_reynolds / (re_to * re_to));
-      for (std::size_t k = 0; k < to.pressure.size(); ++k) {
-        c.tangent.velocity[k] /= length;
-        c.tangent.pressure[k] /= length;
-      }
-      c.tangent_reynolds /= length;
-      return length;
+      return aim_along_secant(c, from, re_from, to, re_to, numbering, PETSC_COMM_WORLD);
     };
     const double secant = aim(earlier, earlier_re, last_good, reached);
     if (!(ds > 0.0)) ds = secant;
@@ -459,36 +456,17 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       branch_point(earlier_re, earlier, 0, -secant);
       branch_point(reached, last_good, 0, 0.0);
     }
-    PicardOptions attempt = picard;
-    attempt.pseudo_cfl = 0.0;
-    attempt.max_iterations = std::min(picard.max_iterations, 25);
-    attempt.stall_steps = 5;
-    attempt.tolerance = std::max(picard.tolerance, job.step_tolerance);
+    const PicardOptions attempt = newton_only();
     for (int k = 0; k < job.arclength_steps && ds >= smallest; ++k) {
       c.origin = last_good;
       c.origin_reynolds = reached;
       c.step = ds;
-      FlowField guess = last_good;
-      for (std::size_t i = 0; i < guess.pressure.size(); ++i) {
-        guess.velocity[i] += ds * c.tangent.velocity[i];
-        guess.pressure[i] += ds * c.tangent.pressure[i];
-      }
+      const FlowField guess = arclength_predictor(c);
       const double re_guess = reached + ds * c.tangent_reynolds;
       ContinuationStep cs;
       cs.arclength = true;
       cs.reynolds = re_guess;
-      Stopwatch clock;
-      PicardReport report;
-      FlowField found;
-      try {
-        found = solve_navier_stokes(local, numbering, 1.0 / re_guess, {}, bc, attempt, &report,
-                                    &guess, &c);
-        cs.converged = report.converged && report.reynolds > 0.0;
-        cs.reynolds = report.reynolds;
-      } catch (const Error& e) {
-        log_line(fmt::format("  arclength step from Re {:.2f}: {}", reached, e.what()));
-      }
-      record(cs, report, clock);
+      FlowField found = solve_step(cs, re_guess, attempt, &guess, &c);
       log_line(
           fmt::format("  Re {:8.2f}: {} after {} Newton steps on the branch (arclength {:.3g}), "
                       "residual {:.2e}, {:.1f} s",
@@ -506,19 +484,10 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
         const FlowField start = blend(last_good, found, t);
         ContinuationStep last;
         last.reynolds = r.reynolds;
-        Stopwatch at;
-        PicardReport final_report;
         PicardOptions exact = attempt;
         exact.tolerance = picard.tolerance;
-        try {
-          FlowField f = solve_navier_stokes(local, numbering, 1.0 / r.reynolds, {}, bc, exact,
-                                            &final_report, &start);
-          last.converged = final_report.converged;
-          if (last.converged) field = std::move(f);
-        } catch (const Error& e) {
-          log_line(fmt::format("  Re {:.1f}: {}", r.reynolds, e.what()));
-        }
-        record(last, final_report, at);
+        FlowField at_target = solve_step(last, r.reynolds, exact, &start, nullptr);
+        if (last.converged) field = std::move(at_target);
         log_line(fmt::format("  Re {:8.1f}: {} after {} Newton steps, residual {:.2e}, {:.1f} s",
                              r.reynolds, last.converged ? "converged" : "FAILED", last.iterations,
                              last.residual, last.seconds));
@@ -582,8 +551,6 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   for (int s = 0; s < job.max_steps && reached < r.reynolds; ++s) {
     ContinuationStep cs;
     cs.reynolds = re;
-    Stopwatch clock;
-    PicardReport report;
     PicardOptions attempt = picard;
     if (re < r.reynolds) attempt.tolerance = std::max(picard.tolerance, job.step_tolerance);
     const bool pseudo = pseudo_available && (pseudo_first != retry);
@@ -604,17 +571,11 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       const double t = (1.0 / re - 1.0 / reached) / (1.0 / reached - 1.0 / earlier_re);
       predicted = blend(earlier, last_good, 1.0 + t);
     }
-    try {
-      field = solve_navier_stokes(local, numbering, 1.0 / re, {}, bc, attempt, &report,
-                                  predict                       ? &predicted
-                                  : !last_good.pressure.empty() ? &last_good
-                                                                : nullptr);
-      cs.converged = report.converged;
-    } catch (const Error& e) {
-      cs.converged = false;  // a diverged iteration: treated as a failed step
-      log_line(fmt::format("  Re {:.1f}: {}", re, e.what()));
-    }
-    record(cs, report, clock);
+    field = solve_step(cs, re, attempt,
+                       predict                       ? &predicted
+                       : !last_good.pressure.empty() ? &last_good
+                                                     : nullptr,
+                       nullptr);
     log_line(fmt::format("  Re {:8.1f}: {} after {} nonlinear steps{}, residual {:.2e}, {:.1f} s",
                          re, cs.converged ? "converged" : "FAILED", cs.iterations,
                          pseudo ? " with pseudo-time" : "", cs.residual, cs.seconds));

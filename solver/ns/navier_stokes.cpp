@@ -415,6 +415,34 @@ double velocity_inner_product(const FlowField& a, const FlowField& b,
   return sum / static_cast<double>(numbering.global_nodes);
 }
 
+double aim_along_secant(ArclengthConstraint& c, const FlowField& from, double re_from,
+                        const FlowField& to, double re_to, const parallel::NodeNumbering& numbering,
+                        MPI_Comm comm) {
+  c.tangent = to;
+  for (std::size_t k = 0; k < to.pressure.size(); ++k) {
+    c.tangent.velocity[k] -= from.velocity[k];
+    c.tangent.pressure[k] -= from.pressure[k];
+  }
+  c.tangent_reynolds = re_to - re_from;
+  const double length = std::sqrt(velocity_inner_product(c.tangent, c.tangent, numbering, comm) +
+                                  c.tangent_reynolds * c.tangent_reynolds / (re_to * re_to));
+  for (std::size_t k = 0; k < to.pressure.size(); ++k) {
+    c.tangent.velocity[k] /= length;
+    c.tangent.pressure[k] /= length;
+  }
+  c.tangent_reynolds /= length;
+  return length;
+}
+
+FlowField arclength_predictor(const ArclengthConstraint& c) {
+  FlowField guess = c.origin;
+  for (std::size_t k = 0; k < guess.pressure.size(); ++k) {
+    guess.velocity[k] += c.step * c.tangent.velocity[k];
+    guess.pressure[k] += c.step * c.tangent.pressure[k];
+  }
+  return guess;
+}
+
 FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumbering& numbering,
                               double nu, const BodyForce& force, const DirichletConditions& bc,
                               const PicardOptions& options, PicardReport* report,

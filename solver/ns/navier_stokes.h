@@ -120,6 +120,16 @@ FlowField solve_navier_stokes(const HybridMesh& piece, const parallel::NodeNumbe
 double velocity_inner_product(const FlowField& a, const FlowField& b,
                               const parallel::NodeNumbering& numbering, MPI_Comm comm);
 
+// Points the constraint's tangent along the secant from (from, Re₀) to (to, Re₁): (to − from,
+// Re₁ − Re₀) divided by its length in the constraint's metric, √(⟨δu, δu⟩ + (δRe/Re₁)²), which
+// it returns (the step that would reach `to` again from `from`). Collective.
+double aim_along_secant(ArclengthConstraint& c, const FlowField& from, double re_from,
+                        const FlowField& to, double re_to, const parallel::NodeNumbering& numbering,
+                        MPI_Comm comm);
+
+// The predictor of a step: origin + step · tangent (its Re: origin_reynolds + step · t_Re).
+FlowField arclength_predictor(const ArclengthConstraint& c);
+
 // The same from the whole mesh on every rank: the ranks cut it into pieces, solve, and each
 // gets the whole field back. For tests and small problems.
 FlowField solve_navier_stokes(const HybridMesh& mesh, double nu, const BodyForce& force,

@@ -253,26 +253,8 @@ TEST(NavierStokes, ArclengthStepFindsTheSolutionAtTheReItReports) {
     ArclengthConstraint c;
     c.origin = to;
     c.origin_reynolds = re_to;
-    c.tangent = to;
-    for (std::size_t k = 0; k < to.pressure.size(); ++k) {
-      c.tangent.velocity[k] -= from.velocity[k];
-      c.tangent.pressure[k] -= from.pressure[k];
-    }
-    c.tangent_reynolds = re_to - re_from;
-    const double length =
-        std::sqrt(velocity_inner_product(c.tangent, c.tangent, whole, PETSC_COMM_WORLD) +
-                  std::pow(c.tangent_reynolds / re_to, 2));
-    for (std::size_t k = 0; k < to.pressure.size(); ++k) {
-      c.tangent.velocity[k] /= length;
-      c.tangent.pressure[k] /= length;
-    }
-    c.tangent_reynolds /= length;
-    c.step = length;
-    FlowField guess = to;
-    for (std::size_t k = 0; k < guess.pressure.size(); ++k) {
-      guess.velocity[k] += c.step * c.tangent.velocity[k];
-      guess.pressure[k] += c.step * c.tangent.pressure[k];
-    }
+    c.step = aim_along_secant(c, from, re_from, to, re_to, whole, PETSC_COMM_WORLD);
+    const FlowField guess = arclength_predictor(c);
     // The predictor's Re, 3 too far: the corrector has to bring Re back to the hyperplane.
     const double re_guess = re_to + c.step * c.tangent_reynolds;
     const double re_start = re_guess + (forwards ? 3.0 : -3.0);
