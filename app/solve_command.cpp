@@ -124,6 +124,11 @@ void add_solve_command(CLI::App& app) {
                       "and may be at the target Re itself");
   restart_mesh->needs(restart);
   cmd->add_flag("--verbose", o->verbose, "a line per nonlinear (Picard or Newton) step");
+  cmd->add_option("--progress", job.picard.progress_seconds,
+                  "seconds between progress lines in a long solve: a nonlinear step's line, and "
+                  "within a linear solve that runs longer, its residual (0: none)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--petsc", o->petsc_options,
                   "PETSc options for the linear solves (prefix ns_), e.g. \"-ns_ksp_monitor\"");
   cmd->add_option("-o,--output", job.output, "output folder")->capture_default_str();

@@ -531,6 +531,29 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
       if (!set) check(PetscOptionsSetValue(nullptr, key.c_str(), value), "PetscOptionsSetValue");
     }
   }
+  // A line now and then from a long linear solve, which otherwise runs silent for minutes.
+  struct LinearProgress {
+    Stopwatch clock;
+    double interval = 0.0, last = 0.0, start_norm = 0.0;
+  } progress{Stopwatch(), options.progress_seconds};
+  if (options.progress_seconds > 0.0) {
+    auto monitor = [](KSP solver, PetscInt it, PetscReal norm, void* context) -> PetscErrorCode {
+      auto& p = *static_cast<LinearProgress*>(context);
+      if (it == 0) {
+        p = {Stopwatch(), p.interval, 0.0, norm};
+        return 0;
+      }
+      const double now = p.clock.seconds();
+      if (now - p.last < p.interval) return 0;
+      p.last = now;
+      KSPType type = nullptr;
+      PetscCall(KSPGetType(solver, &type));
+      log_line(fmt::format("      {} {:5d}: residual {:.2e} of the solve's first, {:.0f} s", type,
+                           static_cast<int>(it), norm / p.start_norm, now));
+      return 0;
+    };
+    check(KSPMonitorSet(ksp, monitor, &progress, nullptr), "KSPMonitorSet");
+  }
   check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
   // As set, by default or from the command line: the tightest relative tolerance and the
   // iteration limit.
@@ -584,6 +607,8 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
     picard_run = options.picard_steps;  // the predictor is close: Newton from the first step
   }
   bool newton_step = false;  // the kind of the last solve
+  Stopwatch solve_clock;
+  double last_line = 0.0;  // when the last step's line was printed, s into the solve
   for (int it = 0; solves <= options.max_iterations + 1 && it < 4 * options.max_iterations + 8;
        ++it) {
     system.distribute(field, current);
@@ -794,7 +819,10 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
     }
     check(VecAYPX(system.solution(), 1.0, current), "VecAYPX");
     ++solves;
-    if (options.log_iterations && system.rank() == 0)
+    const bool progress_due = options.progress_seconds > 0.0 &&
+                              solve_clock.seconds() - last_line >= options.progress_seconds;
+    if (progress_due) last_line = solve_clock.seconds();
+    if ((options.log_iterations || progress_due) && system.rank() == 0)
       log_line(fmt::format(
           "    {} {:3d}: residual {:.3e}, relaxation {:.3f}, CFL {:.3g}, {}{}",
           newton ? "Newton" : "Picard", solves, stokes ? NAN : previous_norm, stokes ? 1.0 : omega,

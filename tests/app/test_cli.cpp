@@ -527,6 +527,33 @@ TEST_F(Cli, SolvesTheFlowThroughACutBall) {
   EXPECT_NE(text.find("\"inlet_profile\": \"expression 3 + 0*x*r\""), std::string::npos) << text;
 }
 
+// Progress on long work: with --progress S a solve prints a nonlinear step's line once S
+// seconds have passed since the last, and a Krylov line every S seconds of a linear solve; the
+// cut ball solves in a fraction of a second, so a tiny S prints them all, and 0 none.
+TEST_F(Cli, LongSolvesPrintProgress) {
+  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const fs::path mesh = dir_ / "ball" / "mesh.h5";
+  CliRun r = naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::regex step_line("\\n    (Picard|Newton) +[0-9]+: residual ");
+  const std::regex krylov_line("\\n      gmres +[0-9]+: residual [0-9.e+-]+ of the solve's first");
+  r = naris("solve " + mesh.string() + " --re 20 --progress 1e-9 -o " +
+            (dir_ / "ball" / "often").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(r.err, step_line)) << r.err;
+  EXPECT_TRUE(std::regex_search(r.err, krylov_line)) << r.err;
+  for (const char* every : {"0", "60"}) {
+    r = naris("solve " + mesh.string() + " --re 20 --progress " + every + " -o " +
+              (dir_ / "ball" / "never").string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_FALSE(std::regex_search(r.err, step_line)) << every << ":\n" << r.err;
+    EXPECT_FALSE(std::regex_search(r.err, krylov_line)) << every << ":\n" << r.err;
+  }
+  expect_clean_failure(
+      naris("solve " + mesh.string() + " --progress -1 -o " + (dir_ / "out").string()),
+      "--progress");
+}
+
 // A checkpoint taken while following a branch by arclength resumes on the branch: from the
 // Newton steps at Re 6 and 8 through the cut ball, marked as points of a branch, the run follows
 // it by arclength until Re passes 20, converges at 20 itself — the answer of a run that goes
