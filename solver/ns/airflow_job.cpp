@@ -390,10 +390,11 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
                                     branch_rows);
   };
   // One solve of the continuation at Re `re_solve` (with `constraint`: its predictor's), its
-  // counts into `cs`, which joins the history. A diverged iteration is a failed try; the field
-  // is then empty.
+  // counts into `cs`, which joins the history (and the whole report into `kept`, if given). A
+  // diverged iteration is a failed try; the field is then empty.
   auto solve_step = [&](ContinuationStep& cs, double re_solve, const PicardOptions& options,
-                        const FlowField* initial, const ArclengthConstraint* constraint) {
+                        const FlowField* initial, const ArclengthConstraint* constraint,
+                        PicardReport* kept = nullptr) {
     Stopwatch clock;
     PicardReport report;
     FlowField f;
@@ -413,6 +414,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     cs.residual = report.residuals.empty() ? NAN : report.residuals.back();
     cs.seconds = clock.seconds();
     r.steps.push_back(cs);
+    if (kept) *kept = std::move(report);
     return f;
   };
   // Newton alone on a short budget, to the steps' tolerance: the points of the branch.
@@ -466,7 +468,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
       ContinuationStep cs;
       cs.arclength = true;
       cs.reynolds = re_guess;
-      FlowField found = solve_step(cs, re_guess, attempt, &guess, &c);
+      PicardReport report;
+      FlowField found = solve_step(cs, re_guess, attempt, &guess, &c, &report);
       log_line(
           fmt::format("  Re {:8.2f}: {} after {} Newton steps on the branch (arclength {:.3g}), "
                       "residual {:.2e}, {:.1f} s",
@@ -502,17 +505,24 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
         ds *= 0.5;  // closer to the target next time
         continue;
       }
-      // The branch turns where Re, along it, stops growing (or falling).
+      // The branch turns where Re, along it, stops growing (or falling): where the tangent at
+      // the new point (the secant only if the solve gave none) points back in Re.
       const double previous_direction = c.tangent_reynolds;
       earlier = std::move(last_good);
       earlier_re = reached;
       last_good = std::move(found);
       reached = re_new;
-      aim(earlier, earlier_re, last_good, reached);
+      if (!report.tangent.pressure.empty()) {
+        c.tangent = std::move(report.tangent);
+        c.tangent_reynolds = report.tangent_reynolds;
+      } else {
+        aim(earlier, earlier_re, last_good, reached);
+      }
       if (previous_direction * c.tangent_reynolds < 0.0) {
-        turns.push_back(earlier_re);
-        log_line(
-            fmt::format("  the branch turns back near Re {:.2f} (a turning point)", earlier_re));
+        const double turn = previous_direction > 0.0 ? std::max(earlier_re, reached)
+                                                     : std::min(earlier_re, reached);
+        turns.push_back(turn);
+        log_line(fmt::format("  the branch turns back near Re {:.2f} (a turning point)", turn));
       }
       lowest = std::min(lowest, reached);
       highest = std::max(highest, reached);

@@ -601,6 +601,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
   int solves = 0, decreasing = 0, picard_run = 0;
   // ∂R/∂Re by a forward difference, and the second solve's answer b, in their own vectors.
   petsc::Vector sensitivity, sensitivity_solution;
+  bool sensitivity_solved = false;
   if (arclength) {
     check(VecDuplicate(system.solution(), sensitivity.out()), "VecDuplicate");
     check(VecDuplicate(system.solution(), sensitivity_solution.out()), "VecDuplicate");
@@ -681,6 +682,25 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
           on_constraint) {
         r.residuals.push_back(norm);
         r.converged = true;
+        if (arclength && sensitivity_solved) {
+          // The tangent from b = du/dRe (J b = −∂R/∂Re), not from the secant through two
+          // points: points converged to 1e-5 carry errors as large as a short step near the
+          // neonate's Re 467, where the secant through them reversed and a turn was claimed
+          // on a branch whose Δp(Re) stayed straight.
+          r.tangent = field;
+          system.gather(sensitivity_solution, r.tangent);
+          double length = std::sqrt(velocity_inner_product(r.tangent, r.tangent, numbering, comm) +
+                                    1.0 / (reynolds * reynolds));
+          if (velocity_inner_product(r.tangent, arclength->tangent, numbering, comm) +
+                  arclength->tangent_reynolds / (reynolds * reynolds) <
+              0.0)
+            length = -length;
+          for (std::size_t k = 0; k < n; ++k) {
+            r.tangent.velocity[k] /= length;
+            r.tangent.pressure[k] /= length;
+          }
+          r.tangent_reynolds = 1.0 / length;
+        }
         break;
       }
       // Under pseudo-time every step is taken: a transient may have to raise the residual on
@@ -802,6 +822,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
       check(KSPSetTolerances(ksp, eta, PETSC_DEFAULT, PETSC_DEFAULT, max_linear_iterations),
             "KSPSetTolerances");
       check(KSPSolve(ksp, system.rhs(), sensitivity_solution), "KSPSolve");
+      sensitivity_solved = true;
       PetscInt its = 0;
       check(KSPGetIterationNumber(ksp, &its), "KSPGetIterationNumber");
       check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");

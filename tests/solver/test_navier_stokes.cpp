@@ -287,6 +287,27 @@ TEST(NavierStokes, ArclengthStepFindsTheSolutionAtTheReItReports) {
       scale = std::max(scale, direct.velocity[k].norm());
     }
     EXPECT_LT(du, 1e-7 * scale) << (forwards ? "forwards" : "backwards");
+    // The branch's tangent there, against a central difference of solutions at Re ± 0.5: unit
+    // in the constraint's metric, pointing on along the step.
+    ASSERT_EQ(report.tangent.velocity.size(), mesh.nodes.size());
+    const double re = report.reynolds;
+    const FlowField above = solve_navier_stokes(mesh, whole, 1.0 / (re + 0.5), force, bc, o,
+                                                nullptr, &direct),
+                    below = solve_navier_stokes(mesh, whole, 1.0 / (re - 0.5), force, bc, o,
+                                                nullptr, &direct);
+    FlowField slope = above;  // du/dRe
+    for (std::size_t k = 0; k < slope.pressure.size(); ++k) slope.velocity[k] -= below.velocity[k];
+    const auto metric = [&](const FlowField& a, double a_re, const FlowField& b, double b_re) {
+      return velocity_inner_product(a, b, whole, PETSC_COMM_WORLD) + a_re * b_re / (re * re);
+    };
+    const double t_re = report.tangent_reynolds;
+    EXPECT_NEAR(metric(report.tangent, t_re, report.tangent, t_re), 1.0, 1e-12);
+    EXPECT_GT(t_re * c.tangent_reynolds, 0.0);
+    const double cosine =
+        metric(report.tangent, t_re, slope, 1.0) / std::sqrt(metric(slope, 1.0, slope, 1.0));
+    EXPECT_GT(std::abs(cosine), 1.0 - 1e-6) << (forwards ? "forwards" : "backwards");
+    std::printf("[ info ] tangent against the central difference: 1 - cos = %.2e\n",
+                1.0 - std::abs(cosine));
   }
 }
 
