@@ -444,7 +444,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     log_line(fmt::format("  following the branch through Re {:.2f} and {:.2f} by arclength",
                          earlier_re, reached));
     const double re_first = reached;
-    // The secant through the last two points, unit in the constraint's metric.
+    // The first step goes along the secant through the last two points (unit in the
+    // constraint's metric); later ones along the tangent each solve reports.
     ArclengthConstraint c;
     auto aim = [&](const FlowField& from, double re_from, const FlowField& to, double re_to) {
       return aim_along_secant(c, from, re_from, to, re_to, numbering, PETSC_COMM_WORLD);
