@@ -88,6 +88,14 @@ class Cli : public ::testing::Test {
 
   std::string out() const { return "-o " + (dir_ / "out" / "mesh.h5").string(); }
 
+  // The solver tests' case: the 12³ ball meshed into `mesh` with an inlet at k = 3 and an
+  // outlet at k = 8.
+  void mesh_cut_ball(const fs::path& mesh) {
+    const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+    const CliRun r = naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+
   // A number from the summary.json in `folder` (six significant digits).
   static double summary(const fs::path& folder, const std::string& key) {
     std::ifstream file(folder / "summary.json");
@@ -489,12 +497,10 @@ TEST_F(CliRunCase, BadCaseFilesAreClearErrors) {
 }
 
 TEST_F(Cli, SolvesTheFlowThroughACutBall) {
-  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
   const fs::path mesh = dir_ / "out" / "mesh.h5";
-  CliRun r = naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string());
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
   const fs::path solution = dir_ / "out" / "solution";
-  r = naris("solve " + mesh.string() + " --re 20 -o " + solution.string());
+  CliRun r = naris("solve " + mesh.string() + " --re 20 -o " + solution.string());
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* f : {"solution.h5", "solution.xdmf", "solution.vtu", "summary.json",
                         "residuals.csv", "checkpoint.h5"})
@@ -531,14 +537,12 @@ TEST_F(Cli, SolvesTheFlowThroughACutBall) {
 // seconds have passed since the last, and a Krylov line every S seconds of a linear solve; the
 // cut ball solves in a fraction of a second, so a tiny S prints them all, and 0 none.
 TEST_F(Cli, LongSolvesPrintProgress) {
-  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
   const fs::path mesh = dir_ / "ball" / "mesh.h5";
-  CliRun r = naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string());
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
   const std::regex step_line("\\n    (Picard|Newton) +[0-9]+: residual ");
   const std::regex krylov_line("\\n      gmres +[0-9]+: residual [0-9.e+-]+ of the solve's first");
-  r = naris("solve " + mesh.string() + " --re 20 --progress 1e-9 -o " +
-            (dir_ / "ball" / "often").string());
+  CliRun r = naris("solve " + mesh.string() + " --re 20 --progress 1e-9 -o " +
+                   (dir_ / "ball" / "often").string());
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(std::regex_search(r.err, step_line)) << r.err;
   EXPECT_TRUE(std::regex_search(r.err, krylov_line)) << r.err;
@@ -559,10 +563,8 @@ TEST_F(Cli, LongSolvesPrintProgress) {
 // it by arclength until Re passes 20, converges at 20 itself — the answer of a run that goes
 // there by Re alone — and lists the points in branch.csv, Re rising along this branch.
 TEST_F(Cli, ResumedBranchIsFollowedByArclengthToTheTarget) {
-  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
   const fs::path mesh = dir_ / "out" / "mesh.h5";
-  ASSERT_EQ(naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string()).status,
-            0);
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
   const std::string solve = "solve " + mesh.string() + " --pseudo-cfl 0";
   const fs::path direct = dir_ / "out" / "direct", low = dir_ / "out" / "low",
                  branch = dir_ / "out" / "branch";
@@ -631,10 +633,8 @@ TEST_F(Cli, RestartOnTheSubdividedMeshProlongsTheCoarseSolution) {
 // next increment, the method and the earlier step of the secant predictor) — with pseudo-time
 // (the default, every step after the first from rest) and with Newton alone (the predictor).
 TEST_F(Cli, RestartTakesTheUninterruptedPath) {
-  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
   const fs::path mesh = dir_ / "out" / "mesh.h5";
-  ASSERT_EQ(naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string()).status,
-            0);
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
   // residuals.csv rows without the step number: Re, converged, iteration, residual.
   auto rows = [](const fs::path& folder) {
     std::ifstream file(folder / "residuals.csv");
@@ -686,10 +686,8 @@ TEST_F(Cli, RestartTakesTheUninterruptedPath) {
 // which each rank writes a piece of; the answer is the serial one to the six digits of
 // summary.json.
 TEST_F(Cli, SolveOnTwoRanksMatchesOneRank) {
-  const fs::path in = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
   const fs::path mesh = dir_ / "in" / "mesh.h5";
-  ASSERT_EQ(naris("mesh " + in.string() + " --inlet k=3 --outlet k=8 -o " + mesh.string()).status,
-            0);
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
   const fs::path one = dir_ / "one", two = dir_ / "two";
   ASSERT_EQ(naris("solve " + mesh.string() + " --re 40 -o " + one.string()).status, 0);
   const CliRun r = naris("solve " + mesh.string() + " --re 40 -o " + two.string(),
