@@ -845,9 +845,11 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
     if (progress_due) last_line = solve_clock.seconds();
     if ((options.log_iterations || progress_due) && system.rank() == 0)
       log_line(fmt::format(
-          "    {} {:3d}: residual {:.3e}, relaxation {:.3f}, CFL {:.3g}, {}{}",
-          newton ? "Newton" : "Picard", solves, stokes ? NAN : previous_norm, stokes ? 1.0 : omega,
-          stokes ? INFINITY : cfl, linear,
+          "    {} {:3d}: {}, relaxation {:.3f}, CFL {:.3g}, {}{}", newton ? "Newton" : "Picard",
+          solves,
+          // The Stokes start has no residual before it: its solve is the first iterate.
+          stokes ? std::string("Stokes start") : fmt::format("residual {:.3e}", previous_norm),
+          stokes ? 1.0 : omega, stokes ? INFINITY : cfl, linear,
           arclength ? fmt::format(", Re {:.4f} → {:.4f}", reynolds, reynolds + reynolds_step)
                     : ""));
     if (reason < 0) fail("the linear solver failed ({})", KSPConvergedReasons[reason]);
