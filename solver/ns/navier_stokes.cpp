@@ -601,7 +601,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
   int solves = 0, decreasing = 0, picard_run = 0;
   // ∂R/∂Re by a forward difference, and the second solve's answer b, in their own vectors.
   petsc::Vector sensitivity, sensitivity_solution;
-  bool sensitivity_solved = false;
+  bool tangent_known = false;  // the last bordered solve's b is du/dRe
   if (arclength) {
     check(VecDuplicate(system.solution(), sensitivity.out()), "VecDuplicate");
     check(VecDuplicate(system.solution(), sensitivity_solution.out()), "VecDuplicate");
@@ -682,7 +682,7 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
           on_constraint) {
         r.residuals.push_back(norm);
         r.converged = true;
-        if (arclength && sensitivity_solved) {
+        if (arclength && tangent_known) {
           // The tangent from b = du/dRe (J b = −∂R/∂Re), not from the secant through two
           // points: points converged to 1e-5 carry errors as large as a short step near the
           // neonate's Re 467, where the secant through them reversed and a turn was claimed
@@ -822,7 +822,8 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const parallel::NodeNumber
       check(KSPSetTolerances(ksp, eta, PETSC_DEFAULT, PETSC_DEFAULT, max_linear_iterations),
             "KSPSetTolerances");
       check(KSPSolve(ksp, system.rhs(), sensitivity_solution), "KSPSolve");
-      sensitivity_solved = true;
+      // b = du/dRe only with Newton's derivative; after a Picard step it is not the tangent.
+      tangent_known = newton;
       PetscInt its = 0;
       check(KSPGetIterationNumber(ksp, &its), "KSPGetIterationNumber");
       check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");

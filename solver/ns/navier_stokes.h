@@ -105,8 +105,8 @@ struct PicardReport {
   int linear_iterations = 0;
   bool converged = false;
   double reynolds = 0.0;  // with an arclength constraint: the Re of the answer (else 1/ν)
-  // With an arclength constraint, once a Newton step has been taken: the branch's unit tangent
-  // at the answer, (du/dRe, 1) from the last step's ∂R/∂Re solve, scaled to unit length in the
+  // With an arclength constraint, when the last step was Newton's: the branch's unit tangent
+  // at the answer, (du/dRe, 1) from that step's ∂R/∂Re solve, scaled to unit length in the
   // constraint's metric at the answer's Re and pointing the constraint's way (on the piece;
   // its pressure is dp/dRe alike). Empty otherwise.
   FlowField tangent;
