@@ -31,4 +31,7 @@ void add_eog_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_segment_command(CLI::App& app);
 
+// PETSc options (a `petsc` setting) into PETSc's database; -log_view begins the event log.
+void insert_petsc_options(const std::string& options);
+
 }  // namespace naris::app

@@ -6,15 +6,15 @@
 #include <filesystem>
 #include <memory>
 
-#include "commands.h"
+#include "app/commands.h"
 #include "core/error.h"
 #include "core/log.h"
-#include "figures/line_plot.h"
-#include "io/atomic_file.h"
-#include "olfaction/identify.h"
-#include "olfaction/model_io.h"
-#include "olfaction/oe_model.h"
-#include "olfaction/signal.h"
+#include "postproc/figures/line_plot.h"
+#include "core/atomic_file.h"
+#include "postproc/olfaction/identify.h"
+#include "postproc/olfaction/model_io.h"
+#include "postproc/olfaction/oe_model.h"
+#include "postproc/olfaction/signal.h"
 
 namespace naris::app {
 namespace {

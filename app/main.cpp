@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <exception>
 
-#include "commands.h"
+#include "app/commands.h"
 #include "core/error.h"
 #include "core/log.h"
 

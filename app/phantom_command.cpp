@@ -1,9 +1,9 @@
 // `naris phantom`: the procedural CT of a right nasal cavity, the project's default case.
 #include <memory>
 
-#include "commands.h"
+#include "app/commands.h"
 #include "core/log.h"
-#include "pipeline/image_jobs.h"
+#include "mesh/image/image_jobs.h"
 
 namespace naris::app {
 

@@ -1,5 +1,5 @@
-// `naris run case.yaml`: the stages of a case, from the CT (or the phantom) to the mesh, one
-// file each. A stage is skipped when its outputs are newer than its inputs and its settings are
+// `naris run case.yaml`: the stages of a case, from the CT (or the phantom) to the flow, one
+// file (or folder) each. A stage is skipped when its outputs are newer than its inputs and its settings are
 // the ones it last ran with (kept in <output>/.naris-run/); `--force` runs everything.
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -12,21 +12,28 @@
 #include <set>
 #include <sstream>
 
-#include "commands.h"
+#include "app/commands.h"
+#include "app/stage_settings.h"
+#include "solver/parallel/petsc.h"
 #include "core/error.h"
 #include "core/log.h"
-#include "image/phantom.h"
-#include "image/read_volume.h"
-#include "io/atomic_file.h"
-#include "pipeline/image_jobs.h"
-#include "pipeline/mesh_job.h"
+#include "mesh/image/phantom.h"
+#include "mesh/image/read_volume.h"
+#include "core/atomic_file.h"
+#include "mesh/image/image_jobs.h"
+#include "mesh/pipeline/mesh_job.h"
 
 namespace naris::app {
 namespace fs = std::filesystem;
 
 namespace {
 
-// A case-file section read strictly: every key must be known, every value of the right type.
+bool present(const YAML::Node& node) { return node && !node.IsNull(); }
+// A section's settings as text: a stage reruns when they change.
+std::string dump(const YAML::Node& node) { return present(node) ? YAML::Dump(node) : ""; }
+
+// A case-file section of the phantom and the top level read strictly: every key must be known,
+// every value of the right type.
 class Section {
  public:
   Section(YAML::Node node, std::string where) : node_(std::move(node)), where_(std::move(where)) {
@@ -60,8 +67,6 @@ class Section {
         fail("{}: unknown setting '{}' (known: {})", where_, key, fmt::join(known_, ", "));
     }
   }
-  // The settings as text: a stage reruns when they change.
-  std::string fingerprint() const { return present() ? YAML::Dump(node_) : ""; }
 
  private:
   YAML::Node node_;
@@ -129,14 +134,11 @@ void run_case(const RunOptions& o) {
   top.get("output", output);
   top.get("input", input);
   Section phantom_s(root["phantom"], where + ": phantom");
-  Section interp_s(root["interpolate"], where + ": interpolate");
-  Section segment_s(root["segment"], where + ": segment");
-  Section mesh_s(root["mesh"], where + ": mesh");
-  for (const char* key : {"phantom", "interpolate", "segment", "mesh"}) top.allow(key);
+  for (const char* key : {"phantom", "interpolate", "segment", "mesh", "solve"}) top.allow(key);
   top.finish();
   if (phantom_s.present() == !input.empty())
     fail("{}: give either 'input' (a CT volume or DICOM folder) or a 'phantom' section", where);
-  if (!mesh_s.present()) fail("{}: the case has no 'mesh' section", where);
+  if (!present(root["mesh"])) fail("{}: the case has no 'mesh' section", where);
 
   const fs::path out = resolve(output);
   const fs::path stamps = out / ".naris-run";
@@ -159,81 +161,62 @@ void run_case(const RunOptions& o) {
     job->output = ct;
     if (exact_mask) job->exact_mask = exact = out / "exact.nrrd";
     phantom_subject = job->subject;
-    stages.push_back({"phantom", {}, {job->output}, phantom_s.fingerprint(), [job] {
+    stages.push_back({"phantom", {}, {job->output}, dump(root["phantom"]), [job] {
                         return format_phantom_summary(*job, run_phantom_job(*job));
                       }});
     if (exact_mask) stages.back().outputs.push_back(exact);
   }
   // interpolate → interpolated.nrrd
   fs::path image = ct;
-  if (interp_s.present()) {
-    auto job = std::make_shared<InterpolateJob>();
-    std::string method = "hsr";
-    interp_s.get("method", method);
-    interp_s.get("axis", job->axis);
-    interp_s.get("insert", job->insert);
-    interp_s.get("spacing", job->spacing);
-    interp_s.get("block", job->hsr.block);
-    interp_s.get("levels", job->hsr.levels);
-    interp_s.get("iterations", job->hsr.iterations);
-    interp_s.get("threads", job->threads);
-    interp_s.finish();
-    job->method = parse_slice_method(method);
+  if (present(root["interpolate"])) {
+    auto settings = std::make_shared<InterpolateSettings>();
+    settings->table.read(root["interpolate"], where + ": interpolate");
+    auto job = std::make_shared<InterpolateJob>(settings->resolve());
     job->input = image;
     job->output = image = out / "interpolated.nrrd";
-    stages.push_back({"interpolate", {job->input}, {job->output}, interp_s.fingerprint(), [job] {
+    stages.push_back({"interpolate", {job->input}, {job->output}, dump(root["interpolate"]), [job] {
                         return format_interpolate_summary(*job, run_interpolate_job(*job));
                       }});
   }
   // segment → airway.nrrd
   fs::path airway;
-  if (segment_s.present()) {
-    auto job = std::make_shared<SegmentJob>();
-    std::string inside = "below";
-    bool all_components = false;
-    segment_s.get("threshold", job->threshold);
-    segment_s.get("inside", inside);
-    segment_s.get("seeds", job->seeds);
-    segment_s.get("all_components", all_components);
-    segment_s.get("rotate", job->rotate);
-    segment_s.get("decimate", job->decimate);
-    segment_s.finish();
-    if (inside != "below" && inside != "above")
-      fail("{}: segment.inside is '{}': give below or above", where, inside);
-    job->inside_above = inside == "above";
-    job->keep_largest = !all_components;
+  if (present(root["segment"])) {
+    auto settings = std::make_shared<SegmentSettings>();
+    settings->table.read(root["segment"], where + ": segment");
+    auto job = std::make_shared<SegmentJob>(settings->resolve());
     job->input = image;
     job->output = airway = image = out / "airway.nrrd";
-    stages.push_back({"segment", {job->input}, {job->output}, segment_s.fingerprint(), [job] {
+    stages.push_back({"segment", {job->input}, {job->output}, dump(root["segment"]), [job] {
                         return format_segment_summary(*job, run_segment_job(*job));
                       }});
   }
   // mesh → mesh/mesh.h5 and its companions
+  const fs::path mesh_file = out / "mesh" / "mesh.h5";
   {
-    auto job = std::make_shared<MeshJob>();
-    std::string inlet, outlet;
-    std::optional<double> threshold;
-    bool improve = true, msh = true;
-    mesh_s.get("inlet", inlet);
-    mesh_s.get("outlet", outlet);
-    mesh_s.get("patches", job->regions);
-    mesh_s.get("threshold", threshold);
-    mesh_s.get("improve", improve);
-    mesh_s.get("min_edge", job->improve_options.min_edge_fraction);
-    mesh_s.get("subdivide", job->subdivisions);
-    mesh_s.get("msh", msh);
-    mesh_s.finish();
-    if (!inlet.empty()) job->inlet = inlet;
-    if (!outlet.empty()) job->outlet = outlet;
-    job->threshold = threshold;
-    job->improve = improve;
-    job->write_msh = msh;
+    auto settings = std::make_shared<MeshSettings>();
+    settings->table.read(root["mesh"], where + ": mesh");
+    auto job = std::make_shared<MeshJob>(settings->resolve());
     job->input = image;
-    job->output = out / "mesh" / "mesh.h5";
-    stages.push_back({"mesh", {job->input}, {job->output}, mesh_s.fingerprint(), [job] {
+    job->output = mesh_file;
+    stages.push_back({"mesh", {job->input}, {job->output}, dump(root["mesh"]), [job] {
                         MeshJobResult r = run_mesh_job(*job);
                         write_mesh_outputs(*job, r);
                         return format_mesh_summary(*job, r);
+                      }});
+  }
+  // solve → solution/ (the case has a solve: section)
+  if (present(root["solve"])) {
+    auto settings = std::make_shared<SolveSettings>();
+    settings->table.read(root["solve"], where + ": solve");
+    auto job = std::make_shared<airflow::AirflowJob>(settings->resolve(base));
+    job->mesh = mesh_file;
+    job->output = out / "solution";
+    const std::string petsc_options = settings->petsc;
+    stages.push_back({"solve", {job->mesh}, {job->output / "summary.json"}, dump(root["solve"]),
+                      [job, petsc_options] {
+                        petsc::Session session;
+                        insert_petsc_options(petsc_options);
+                        return airflow::format_airflow_summary(*job, airflow::run_airflow_job(*job));
                       }});
   }
 
@@ -283,7 +266,8 @@ void run_case(const RunOptions& o) {
 void add_run_command(CLI::App& app) {
   auto [o, cmd] = add_stage<RunOptions>(
       app, "run",
-      "Run a case file: phantom or input CT → interpolate → segment → mesh, each stage writing "
+      "Run a case file: phantom or input CT → interpolate → segment → mesh → solve, each stage "
+      "writing "
       "its file in the case's output folder and skipped when its outputs are newer than its "
       "inputs and its settings are unchanged");
   cmd->add_option("case", o->case_file, "case file (YAML), e.g. cases/phantom/case.yaml")

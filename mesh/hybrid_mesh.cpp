@@ -1,4 +1,4 @@
-#include "hybrid_mesh.h"
+#include "mesh/hybrid_mesh.h"
 
 #include <algorithm>
 

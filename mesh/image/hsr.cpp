@@ -1,4 +1,4 @@
-#include "image/hsr.h"
+#include "mesh/image/hsr.h"
 
 #include <algorithm>
 #include <cmath>

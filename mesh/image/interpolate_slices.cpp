@@ -1,4 +1,4 @@
-#include "image/interpolate_slices.h"
+#include "mesh/image/interpolate_slices.h"
 
 #include <algorithm>
 #include <atomic>

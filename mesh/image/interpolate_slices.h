@@ -3,8 +3,8 @@
 // between each pair of acquired slices, by HSR or by the linear / shape-based baselines.
 #include <string>
 
-#include "image/hsr.h"
-#include "image/volume.h"
+#include "mesh/image/hsr.h"
+#include "mesh/image/volume.h"
 
 namespace naris {
 

@@ -1,4 +1,4 @@
-#include "image/phantom.h"
+#include "mesh/image/phantom.h"
 
 #include <algorithm>
 #include <atomic>

@@ -17,7 +17,7 @@
 #include <array>
 #include <cstdint>
 
-#include "image/volume.h"
+#include "mesh/image/volume.h"
 
 namespace naris {
 

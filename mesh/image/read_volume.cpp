@@ -1,4 +1,4 @@
-#include "image/read_volume.h"
+#include "mesh/image/read_volume.h"
 
 #include <gdcmDirectory.h>
 #include <gdcmIPPSorter.h>

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <string>
 
-#include "image/volume.h"
+#include "mesh/image/volume.h"
 
 namespace naris {
 

@@ -1,4 +1,4 @@
-#include "image/resample.h"
+#include "mesh/image/resample.h"
 
 #include <algorithm>
 #include <cmath>

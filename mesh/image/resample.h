@@ -2,7 +2,7 @@
 // Geometric preparation of a CT volume before segmentation (dissertation 4.2.3): in-plane
 // decimation by an integer factor, and rotation about an axis (e.g. 30° in the sagittal plane
 // to align the cavity with the grid).
-#include "image/volume.h"
+#include "mesh/image/volume.h"
 
 namespace naris {
 

@@ -1,4 +1,4 @@
-#include "image/segment.h"
+#include "mesh/image/segment.h"
 
 #include <fmt/format.h>
 
@@ -130,9 +130,18 @@ Voxel parse_seed(const std::string& text, const ImageFrame& frame) {
   return voxel;
 }
 
-Volume<std::uint8_t> grow_region(const Volume<float>& image, double threshold, bool inside_above,
+namespace {
+// A threshold's side: below or above (a label is not a threshold).
+bool above(InsideRule side) {
+  if (side == InsideRule::label) fail("internal: a threshold has no label side");
+  return side == InsideRule::above;
+}
+}  // namespace
+
+Volume<std::uint8_t> grow_region(const Volume<float>& image, double threshold, InsideRule side,
                                  const std::vector<Voxel>& seeds) {
   if (seeds.empty()) fail("region growing needs at least one seed");
+  const bool inside_above = above(side);
   Volume<std::uint8_t> mask;
   mask.frame = image.frame;
   mask.values.assign(image.values.size(), 0);
@@ -154,7 +163,8 @@ Volume<std::uint8_t> grow_region(const Volume<float>& image, double threshold, b
 }
 
 Volume<std::uint8_t> threshold_mask(const Volume<float>& image, double threshold,
-                                    bool inside_above) {
+                                    InsideRule side) {
+  const bool inside_above = above(side);
   Volume<std::uint8_t> mask;
   mask.frame = image.frame;
   mask.values.resize(image.values.size());

@@ -8,7 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "image/volume.h"
+#include "mesh/image/inside_rule.h"
+#include "mesh/image/volume.h"
 
 namespace naris {
 
@@ -21,14 +22,13 @@ using Voxel = std::array<int, 3>;
 // "i,j,k" (voxel indices) or "x,y,z mm" / "x,y,z" with the mm suffix (physical millimetres).
 Voxel parse_seed(const std::string& text, const ImageFrame& frame);
 
-// The 26-connected region of voxels with value < threshold (or > when inside_above) reached
+// The 26-connected region of voxels inside by `side` (below or above the threshold) reached
 // from the seeds. Throws naris::Error naming a seed outside the volume or not inside.
-Volume<std::uint8_t> grow_region(const Volume<float>& image, double threshold, bool inside_above,
+Volume<std::uint8_t> grow_region(const Volume<float>& image, double threshold, InsideRule side,
                                  const std::vector<Voxel>& seeds);
 
-// Every voxel with value < threshold (or >) as a mask, no connectivity imposed.
-Volume<std::uint8_t> threshold_mask(const Volume<float>& image, double threshold,
-                                    bool inside_above);
+// Every voxel inside by `side` as a mask, no connectivity imposed.
+Volume<std::uint8_t> threshold_mask(const Volume<float>& image, double threshold, InsideRule side);
 
 struct ComponentSummary {
   std::size_t components = 0;

@@ -1,4 +1,4 @@
-#include "image/write_volume.h"
+#include "mesh/image/write_volume.h"
 
 #include <fmt/format.h>
 #include <zlib.h>
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "io/atomic_file.h"
+#include "core/atomic_file.h"
 
 namespace naris {
 namespace {

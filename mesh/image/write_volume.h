@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 
-#include "image/volume.h"
+#include "mesh/image/volume.h"
 
 namespace naris {
 

@@ -1,4 +1,4 @@
-#include "io/mesh_h5.h"
+#include "mesh/io/mesh_h5.h"
 
 #include <fmt/format.h>
 
@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "core/error.h"
-#include "io/atomic_file.h"
-#include "io/hdf5_table.h"
+#include "core/atomic_file.h"
+#include "core/hdf5_table.h"
 
 namespace naris {
 namespace fs = std::filesystem;

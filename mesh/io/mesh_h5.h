@@ -15,7 +15,7 @@
 // Node ids are 0-based. Every cell has positive volume.
 #include <filesystem>
 
-#include "hybrid_mesh.h"
+#include "mesh/hybrid_mesh.h"
 
 namespace naris {
 

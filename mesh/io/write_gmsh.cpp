@@ -1,4 +1,4 @@
-#include "io/write_gmsh.h"
+#include "mesh/io/write_gmsh.h"
 
 #include <fmt/format.h>
 
@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "core/error.h"
-#include "io/atomic_file.h"
+#include "core/atomic_file.h"
 
 namespace naris {
 

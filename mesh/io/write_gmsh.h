@@ -4,7 +4,7 @@
 // volume group "fluid". Node orders of tet, pyramid and hexahedron match VTK's.
 #include <filesystem>
 
-#include "hybrid_mesh.h"
+#include "mesh/hybrid_mesh.h"
 
 namespace naris {
 

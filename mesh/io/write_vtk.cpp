@@ -1,4 +1,4 @@
-#include "io/write_vtk.h"
+#include "mesh/io/write_vtk.h"
 
 #include <fmt/format.h>
 #include <vtkCellArray.h>
@@ -20,7 +20,7 @@
 #include <memory>
 
 #include "core/error.h"
-#include "io/atomic_file.h"
+#include "core/atomic_file.h"
 
 namespace naris {
 namespace {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "hybrid_mesh.h"
+#include "mesh/hybrid_mesh.h"
 
 namespace naris {
 

@@ -1,4 +1,4 @@
-#include "mve/case_table.h"
+#include "mesh/mve/case_table.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -7,7 +7,7 @@
 #include <random>
 
 #include "core/error.h"
-#include "mve/fill_component.h"
+#include "mesh/mve/fill_component.h"
 
 namespace naris::mve {
 

@@ -1,4 +1,4 @@
-#include "mve/fill_component.h"
+#include "mesh/mve/fill_component.h"
 
 #include <algorithm>
 #include <cmath>

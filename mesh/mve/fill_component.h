@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "mve/case_table.h"
+#include "mesh/mve/case_table.h"
 
 namespace naris::mve {
 

@@ -1,4 +1,4 @@
-#include "mve/mve.h"
+#include "mesh/mve/mve.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,24 +6,24 @@
 
 #include "core/error.h"
 #include "core/log.h"
-#include "mve/case_table.h"
-#include "mve/fill_component.h"
+#include "mesh/mve/case_table.h"
+#include "mesh/mve/fill_component.h"
 
 namespace naris::mve {
 
-VolumeField::VolumeField(const Volume<float>& volume, Mode mode, double level)
-    : volume_(volume), mode_(mode), level_(static_cast<float>(level)) {}
+VolumeField::VolumeField(const Volume<float>& volume, InsideRule rule, double level)
+    : volume_(volume), rule_(rule), level_(static_cast<float>(level)) {}
 
 void VolumeField::read_slice(int k, std::span<float> out) const {
   const auto in = volume_.slice(k);
-  switch (mode_) {
-    case Mode::above:
+  switch (rule_) {
+    case InsideRule::above:
       for (std::size_t n = 0; n < in.size(); ++n) out[n] = in[n] - level_;
       break;
-    case Mode::below:
+    case InsideRule::below:
       for (std::size_t n = 0; n < in.size(); ++n) out[n] = level_ - in[n];
       break;
-    case Mode::label:  // isopoints halfway between voxel centres, as for any binary mask
+    case InsideRule::label:  // isopoints halfway between voxel centres, as for any binary mask
       for (std::size_t n = 0; n < in.size(); ++n) out[n] = in[n] == level_ ? 1.0f : -1.0f;
       break;
   }

@@ -9,8 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "hybrid_mesh.h"
-#include "image/volume.h"
+#include "mesh/hybrid_mesh.h"
+#include "mesh/image/inside_rule.h"
+#include "mesh/image/volume.h"
 
 namespace naris::mve {
 
@@ -64,19 +65,18 @@ struct MveStats {
 HybridMesh march_volume_elements(const FieldSource& field, const MveOptions& options,
                                  MveStats* stats = nullptr);
 
-// A FieldSource over a volume in memory: inside where value > threshold (or < threshold when
-// inside_below), or where value == label.
+// A FieldSource over a volume in memory: inside by `rule` (below or above a threshold, or equal
+// to a label).
 class VolumeField : public FieldSource {
  public:
-  enum class Mode { above, below, label };
-  VolumeField(const Volume<float>& volume, Mode mode, double level);
+  VolumeField(const Volume<float>& volume, InsideRule rule, double level);
   const ImageFrame& frame() const override { return volume_.frame; }
   void read_slice(int k, std::span<float> out) const override;
-  bool binary() const override { return mode_ == Mode::label; }
+  bool binary() const override { return rule_ == InsideRule::label; }
 
  private:
   const Volume<float>& volume_;
-  Mode mode_;
+  InsideRule rule_;
   float level_;
 };
 

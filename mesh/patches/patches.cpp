@@ -1,4 +1,4 @@
-#include "patches/patches.h"
+#include "mesh/patches/patches.h"
 
 #include <algorithm>
 #include <cmath>

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "hybrid_mesh.h"
-#include "mve/mve.h"
+#include "mesh/hybrid_mesh.h"
+#include "mesh/mve/mve.h"
 
 namespace naris {
 

@@ -1,4 +1,4 @@
-#include "pipeline/mesh_job.h"
+#include "mesh/pipeline/mesh_job.h"
 
 #include <fmt/format.h>
 
@@ -8,11 +8,13 @@
 
 #include "core/error.h"
 #include "core/log.h"
-#include "io/atomic_file.h"
-#include "io/mesh_h5.h"
-#include "io/write_gmsh.h"
-#include "io/write_vtk.h"
-#include "refine/subdivide.h"
+#include "core/atomic_file.h"
+#include "core/json.h"
+#include "core/units.h"
+#include "mesh/io/mesh_h5.h"
+#include "mesh/io/write_gmsh.h"
+#include "mesh/io/write_vtk.h"
+#include "mesh/refine/subdivide.h"
 
 namespace naris {
 namespace fs = std::filesystem;
@@ -22,19 +24,19 @@ namespace {
 // Decides what "inside" means and checks that it selects something but not everything.
 mve::VolumeField make_field(const Volume<float>& volume, const MeshJob& job, MeshJobResult& r) {
   const auto& info = r.input;
-  using Mode = mve::VolumeField::Mode;
-  Mode mode;
+  InsideRule mode;
   double level;
   if (job.threshold && job.label) fail("give either --threshold or --label, not both");
   if (job.label) {
-    mode = Mode::label;
+    mode = InsideRule::label;
     level = *job.label;
   } else if (job.threshold) {
     level = *job.threshold;
     if (!(level > info.min_value && level < info.max_value))
       fail("{}: threshold {} is outside the data range [{}, {}]: nothing would be separated",
            job.input.string(), level, info.min_value, info.max_value);
-    mode = job.inside_above ? Mode::above : Mode::below;
+    if (job.inside == InsideRule::label) fail("with a threshold, inside is below or above it");
+    mode = job.inside;
   } else {
     // A binary labelmap (0/1) needs no option: its airway is label 1.
     const bool binary = info.min_value >= 0.0 && info.max_value <= 1.0 &&
@@ -45,14 +47,14 @@ mve::VolumeField make_field(const Volume<float>& volume, const MeshJob& job, Mes
           "{}: the image is not a binary labelmap (values {} .. {}): give --threshold T (CT, "
           "inside below T) or --label L",
           job.input.string(), info.min_value, info.max_value);
-    mode = Mode::label;
+    mode = InsideRule::label;
     level = 1.0;
   }
   std::size_t inside = 0;
   for (float v : volume.values)
-    inside += mode == Mode::label ? v == level : (mode == Mode::above ? v > level : v < level);
+    inside += is_inside(mode, v, level);
   if (inside == 0) {
-    if (mode == Mode::label) {
+    if (mode == InsideRule::label) {
       std::set<float> present;
       for (float v : volume.values) {
         present.insert(v);
@@ -62,43 +64,33 @@ mve::VolumeField make_field(const Volume<float>& volume, const MeshJob& job, Mes
            level, fmt::join(present, ", "));
     }
     fail("{}: no voxel is {} the threshold {}: nothing to mesh", job.input.string(),
-         mode == Mode::above ? "above" : "below", level);
+         inside_rule_name(mode), level);
   }
   if (inside == volume.values.size())
     fail(
         "{}: every voxel is inside ({} {}): the object has no boundary in the image; check the "
         "threshold side (--inside) or crop with --inlet/--outlet",
-        job.input.string(), mode == Mode::label ? "label" : "threshold", level);
+        job.input.string(), mode == InsideRule::label ? "label" : "threshold", level);
   r.level = level;
-  r.mode = mode == Mode::label ? "label" : (mode == Mode::above ? "above" : "below");
+  r.rule = mode;
   return mve::VolumeField(volume, mode, level);
 }
 
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
+Json quality_json(const QualityReport& q) {
+  Json out = Json::object();
+  for (std::size_t g = 0; g < q.groups.size(); ++g) {
+    Json group = Json::object();
+    for (std::size_t m = 0; m < kMetrics.size(); ++m) {
+      const auto& st = q.summary[g][m];
+      group[metric_name(kMetrics[m])] = {
+          {"count", st.count},        {"min", significant(st.min)}, {"p1", significant(st.p1)},
+          {"p5", significant(st.p5)}, {"p50", significant(st.p50)}, {"p95", significant(st.p95)},
+          {"p99", significant(st.p99)}, {"max", significant(st.max)},
+          {"histogram_range", {st.lo, st.hi}}, {"histogram", st.histogram}};
+    }
+    out[q.groups[g]] = std::move(group);
   }
   return out;
-}
-
-std::string quality_json(const QualityReport& q) {
-  std::string out = "{";
-  for (std::size_t g = 0; g < q.groups.size(); ++g) {
-    out += fmt::format("{}\"{}\": {{", g ? ", " : "", q.groups[g]);
-    for (std::size_t m = 0; m < kMetrics.size(); ++m) {
-      const auto& s = q.summary[g][m];
-      out += fmt::format(
-          "{}\"{}\": {{\"count\": {}, \"min\": {:.6g}, \"p1\": {:.6g}, \"p5\": {:.6g}, \"p50\": "
-          "{:.6g}, \"p95\": {:.6g}, \"p99\": {:.6g}, \"max\": {:.6g}, \"histogram_range\": [{}, "
-          "{}], \"histogram\": [{}]}}",
-          m ? ", " : "", metric_name(kMetrics[m]), s.count, s.min, s.p1, s.p5, s.p50, s.p95, s.p99,
-          s.max, s.lo, s.hi, fmt::join(s.histogram, ", "));
-    }
-    out += "}";
-  }
-  return out + "}";
 }
 
 }  // namespace
@@ -188,35 +180,42 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
   r.seconds.push_back({"write", clock.seconds()});
 
   // mesh.json: every number of the summary, for people and for the later stages.
-  std::string patches;
+  Json patches = Json::array(), seconds = Json::object();
   for (const auto& p : r.patches)
-    patches += fmt::format(
-        "{}\n    {{\"name\": \"{}\", \"faces\": {}, \"area_mm2\": {:.6g}, \"perimeter_mm\": "
-        "{:.6g}, "
-        "\"hydraulic_diameter_mm\": {:.6g}}}",
-        patches.empty() ? "" : ",", json_escape(p.name), p.faces, p.area, p.perimeter,
-        p.hydraulic_diameter());
-  std::string seconds;
-  for (const auto& [stage, s] : r.seconds)
-    seconds += fmt::format("{}\"{}\": {:.4f}", seconds.empty() ? "" : ", ", stage, s);
-  const double volume_mm3 = mesh_volume(r.mesh);
-  const std::string json = fmt::format(
-      "{{\n  \"input\": \"{}\",\n  \"mode\": \"{}\",\n  \"level\": {},\n  \"nodes\": {},\n"
-      "  \"cells\": {{\"tet\": {}, \"pyramid\": {}, \"hex\": {}}},\n"
-      "  \"boundary_faces\": {{\"tri\": {}, \"quad\": {}}},\n  \"volume_mm3\": {:.6g},\n"
-      "  \"components\": {},\n  \"dropped_components\": {},\n  \"dropped_cells\": {},\n"
-      "  \"improvement\": {{\"short_edges\": {}, \"collapsed\": {}, \"refused_topology\": {}, "
-      "\"refused_geometry\": {}, \"removed_cells\": {}, \"pyramids_to_tets\": {}}},\n"
-      "  \"patches\": [{}\n  ],\n  \"quality_before\": {},\n  \"quality_after\": {},\n"
-      "  \"seconds\": {{{}}},\n  \"peak_memory_mb\": {:.1f}\n}}\n",
-      json_escape(job.input.string()), r.mode, r.level, r.mesh.nodes.size(), r.mesh.tets.size(),
-      r.mesh.pyramids.size(), r.mesh.hexes.size(), r.mesh.boundary_tris.size(),
-      r.mesh.boundary_quads.size(), volume_mm3, r.mve.components, r.mve.dropped_components,
-      r.mve.dropped_cells, r.improvement.short_edges, r.improvement.collapsed,
-      r.improvement.refused_topology, r.improvement.refused_geometry, r.improvement.removed_cells,
-      r.improvement.pyramids_to_tets, patches, quality_json(r.before), quality_json(r.after),
-      seconds, static_cast<double>(peak_memory_bytes()) / 1e6);
-  write_text_file(sibling("mesh.json"), json);
+    patches.push_back({{"name", p.name},
+                       {"faces", p.faces},
+                       {"area_mm2", significant(p.area)},
+                       {"perimeter_mm", significant(p.perimeter)},
+                       {"hydraulic_diameter_mm", significant(p.hydraulic_diameter())}});
+  for (const auto& [stage, t] : r.seconds) seconds[stage] = significant(t, 5);
+  const ImproveStats& im = r.improvement;
+  const Json json = {
+      {"input", job.input.string()},
+      {"mode", inside_rule_name(r.rule)},
+      {"level", r.level},
+      {"nodes", r.mesh.nodes.size()},
+      {"cells",
+       {{"tet", r.mesh.tets.size()}, {"pyramid", r.mesh.pyramids.size()},
+        {"hex", r.mesh.hexes.size()}}},
+      {"boundary_faces",
+       {{"tri", r.mesh.boundary_tris.size()}, {"quad", r.mesh.boundary_quads.size()}}},
+      {"volume_mm3", significant(mesh_volume(r.mesh))},
+      {"components", r.mve.components},
+      {"dropped_components", r.mve.dropped_components},
+      {"dropped_cells", r.mve.dropped_cells},
+      {"improvement",
+       {{"short_edges", im.short_edges},
+        {"collapsed", im.collapsed},
+        {"refused_topology", im.refused_topology},
+        {"refused_geometry", im.refused_geometry},
+        {"removed_cells", im.removed_cells},
+        {"pyramids_to_tets", im.pyramids_to_tets}}},
+      {"patches", patches},
+      {"quality_before", quality_json(r.before)},
+      {"quality_after", quality_json(r.after)},
+      {"seconds", seconds},
+      {"peak_memory_mb", significant(megabytes(peak_memory_bytes()), 5)}};
+  write_json_file(sibling("mesh.json"), json);
   r.written.push_back(sibling("mesh.json").string());
 }
 
@@ -226,8 +225,8 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
       "naris mesh: {} ({}, {})\n  cells     {} = {} hex + {} pyramid + {} tet\n"
       "  nodes     {}\n  volume    {:.1f} mm³ ({:.3f} mL)\n",
       job.input.filename().string(), r.input.format,
-      r.mode == "label" ? fmt::format("label {}", r.level)
-                        : fmt::format("inside {} {}", r.mode, r.level),
+      r.rule == InsideRule::label ? fmt::format("label {}", r.level)
+                        : fmt::format("inside {} {}", inside_rule_name(r.rule), r.level),
       m.cell_count(), m.hexes.size(), m.pyramids.size(), m.tets.size(), m.nodes.size(),
       mesh_volume(m), mesh_volume(m) / 1000.0);
   if (r.mve.dropped_components)

@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
-#include "hybrid_mesh.h"
-#include "image/read_volume.h"
-#include "mve/mve.h"
-#include "patches/patches.h"
-#include "quality/check.h"
-#include "quality/improve.h"
-#include "quality/quality.h"
+#include "mesh/hybrid_mesh.h"
+#include "mesh/image/read_volume.h"
+#include "mesh/mve/mve.h"
+#include "mesh/patches/patches.h"
+#include "mesh/quality/check.h"
+#include "mesh/quality/improve.h"
+#include "mesh/quality/quality.h"
 
 namespace naris {
 
@@ -21,7 +21,7 @@ struct MeshJob {
   std::filesystem::path input;
   std::optional<double> threshold;  // inside is below it by default (air in CT)
   std::optional<double> label;      // inside is exactly this value
-  bool inside_above = false;        // with a threshold: inside is above it
+  InsideRule inside = InsideRule::below;  // with a threshold: its side (below or above)
   std::optional<std::string> inlet, outlet;
   std::vector<std::string> regions;  // name:box=... or name:sphere=...
   bool keep_largest = true;
@@ -39,7 +39,7 @@ struct MeshJobResult {
   HybridMesh mesh;
   VolumeInfo input;
   double level = 0.0;  // the threshold or label used
-  std::string mode;    // "label", "below" or "above"
+  InsideRule rule = InsideRule::label;  // what inside meant
   mve::MveStats mve;
   ImproveStats improvement;
   std::size_t cells_before_subdivision = 0;  // with subdivisions

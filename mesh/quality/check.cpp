@@ -1,4 +1,4 @@
-#include "quality/check.h"
+#include "mesh/quality/check.h"
 
 #include <fmt/format.h>
 

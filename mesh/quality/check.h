@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <string>
 
-#include "hybrid_mesh.h"
+#include "mesh/hybrid_mesh.h"
 
 namespace naris {
 

@@ -1,4 +1,4 @@
-#include "quality/improve.h"
+#include "mesh/quality/improve.h"
 
 #include <algorithm>
 #include <cmath>

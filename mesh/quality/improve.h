@@ -6,7 +6,7 @@
 // if it keeps the mesh a conforming, watertight manifold and every changed cell positive.
 #include <cstddef>
 
-#include "hybrid_mesh.h"
+#include "mesh/hybrid_mesh.h"
 
 namespace naris {
 

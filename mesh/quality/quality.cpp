@@ -1,4 +1,4 @@
-#include "quality/quality.h"
+#include "mesh/quality/quality.h"
 
 #include <algorithm>
 #include <cmath>

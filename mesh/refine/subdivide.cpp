@@ -1,4 +1,4 @@
-#include "refine/subdivide.h"
+#include "mesh/refine/subdivide.h"
 
 #include <algorithm>
 #include <cstdint>

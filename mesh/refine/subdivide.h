@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "hybrid_mesh.h"
+#include "mesh/hybrid_mesh.h"
 
 namespace naris {
 

@@ -1,4 +1,4 @@
-#include "figures/line_plot.h"
+#include "postproc/figures/line_plot.h"
 
 #include <cairo.h>
 #include <fmt/format.h>
@@ -8,7 +8,7 @@
 #include <memory>
 
 #include "core/error.h"
-#include "io/atomic_file.h"
+#include "core/atomic_file.h"
 
 namespace naris::figures {
 namespace {

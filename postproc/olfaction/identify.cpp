@@ -1,4 +1,4 @@
-#include "olfaction/identify.h"
+#include "postproc/olfaction/identify.h"
 
 #include <Eigen/Dense>
 #include <algorithm>

@@ -5,7 +5,7 @@
 // simulated response on a separate validation record.
 #include <vector>
 
-#include "olfaction/oe_model.h"
+#include "postproc/olfaction/oe_model.h"
 
 namespace naris::olfaction {
 

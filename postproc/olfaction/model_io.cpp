@@ -1,4 +1,4 @@
-#include "olfaction/model_io.h"
+#include "postproc/olfaction/model_io.h"
 
 #include <yaml-cpp/yaml.h>
 

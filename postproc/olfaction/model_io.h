@@ -3,8 +3,8 @@
 #include <filesystem>
 #include <string>
 
-#include "olfaction/oe_model.h"
-#include "olfaction/signal.h"
+#include "postproc/olfaction/oe_model.h"
+#include "postproc/olfaction/signal.h"
 
 namespace naris::olfaction {
 

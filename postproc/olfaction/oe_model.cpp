@@ -1,4 +1,4 @@
-#include "olfaction/oe_model.h"
+#include "postproc/olfaction/oe_model.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>

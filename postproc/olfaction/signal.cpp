@@ -1,4 +1,4 @@
-#include "olfaction/signal.h"
+#include "postproc/olfaction/signal.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>

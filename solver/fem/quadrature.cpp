@@ -1,4 +1,4 @@
-#include "fem/quadrature.h"
+#include "solver/fem/quadrature.h"
 
 #include <algorithm>
 #include <cmath>

@@ -8,7 +8,7 @@
 #include <array>
 #include <span>
 
-#include "fem/reference_element.h"
+#include "solver/fem/reference_element.h"
 
 namespace naris::fem {
 

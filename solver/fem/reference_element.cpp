@@ -1,4 +1,4 @@
-#include "fem/reference_element.h"
+#include "solver/fem/reference_element.h"
 
 namespace naris::fem {
 

@@ -1,4 +1,4 @@
-#include "ns/boundary_conditions.h"
+#include "solver/ns/boundary_conditions.h"
 
 #include <Eigen/Sparse>
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "ns/inlet_expression.h"
+#include "solver/ns/inlet_expression.h"
 
 #include <muParser.h>
 

@@ -1,4 +1,4 @@
-#include "ns/node_graph.h"
+#include "solver/ns/node_graph.h"
 
 #include <algorithm>
 

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "hybrid_mesh.h"
-#include "parallel/partition.h"
-#include "parallel/petsc.h"
+#include "mesh/hybrid_mesh.h"
+#include "solver/parallel/partition.h"
+#include "solver/parallel/petsc.h"
 
 namespace naris::ns {
 

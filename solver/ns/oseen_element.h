@@ -36,8 +36,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "fem/quadrature.h"
-#include "fem/reference_element.h"
+#include "solver/fem/quadrature.h"
+#include "solver/fem/reference_element.h"
 
 namespace naris::ns {
 

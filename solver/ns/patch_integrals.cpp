@@ -1,4 +1,4 @@
-#include "ns/patch_integrals.h"
+#include "solver/ns/patch_integrals.h"
 
 namespace naris::ns {
 

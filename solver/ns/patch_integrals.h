@@ -3,7 +3,7 @@
 // the mean of its corner values): the flux through inlets and outlets, mean pressures.
 #include <vector>
 
-#include "hybrid_mesh.h"
+#include "mesh/hybrid_mesh.h"
 
 namespace naris::ns {
 

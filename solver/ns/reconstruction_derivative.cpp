@@ -1,11 +1,11 @@
-#include "ns/reconstruction_derivative.h"
+#include "solver/ns/reconstruction_derivative.h"
 
 #include <algorithm>
 #include <array>
 #include <utility>
 
-#include "ns/node_graph.h"
-#include "ns/oseen_element.h"
+#include "solver/ns/node_graph.h"
+#include "solver/ns/oseen_element.h"
 
 namespace naris::ns {
 

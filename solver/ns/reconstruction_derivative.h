@@ -18,8 +18,8 @@
 #include <cstddef>
 #include <vector>
 
-#include "hybrid_mesh.h"
-#include "ns/node_graph.h"
+#include "mesh/hybrid_mesh.h"
+#include "solver/ns/node_graph.h"
 
 namespace naris::ns {
 

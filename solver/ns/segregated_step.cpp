@@ -1,4 +1,4 @@
-#include "ns/segregated_step.h"
+#include "solver/ns/segregated_step.h"
 
 #include <vector>
 

@@ -15,7 +15,7 @@
 
 #include <string>
 
-#include "parallel/petsc.h"
+#include "solver/parallel/petsc.h"
 
 namespace naris::ns {
 

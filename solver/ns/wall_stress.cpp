@@ -1,10 +1,10 @@
-#include "ns/wall_stress.h"
+#include "solver/ns/wall_stress.h"
 
 #include <algorithm>
 #include <unordered_map>
 
 #include "core/error.h"
-#include "fem/reference_element.h"
+#include "solver/fem/reference_element.h"
 
 namespace naris::ns {
 namespace {

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "hybrid_mesh.h"
-#include "ns/navier_stokes.h"
+#include "mesh/hybrid_mesh.h"
+#include "solver/ns/flow_field.h"
 
 namespace naris::ns {
 

@@ -1,9 +1,9 @@
-#include "parallel/block_assembly.h"
+#include "solver/parallel/block_assembly.h"
 
 #include <algorithm>
 
 #include "core/error.h"
-#include "parallel/petsc.h"
+#include "solver/parallel/petsc.h"
 
 namespace naris::parallel {
 

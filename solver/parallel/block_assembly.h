@@ -13,7 +13,7 @@
 #include <span>
 #include <vector>
 
-#include "parallel/partition.h"
+#include "solver/parallel/partition.h"
 
 namespace naris::parallel {
 

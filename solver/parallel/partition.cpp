@@ -1,4 +1,4 @@
-#include "parallel/partition.h"
+#include "solver/parallel/partition.h"
 
 #include <algorithm>
 

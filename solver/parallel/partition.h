@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "hybrid_mesh.h"
+#include "mesh/hybrid_mesh.h"
 
 namespace naris::parallel {
 

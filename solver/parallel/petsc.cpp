@@ -1,4 +1,4 @@
-#include "parallel/petsc.h"
+#include "solver/parallel/petsc.h"
 
 #include "core/error.h"
 

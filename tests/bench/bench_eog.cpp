@@ -8,9 +8,9 @@
 #include <random>
 
 #include "core/log.h"
-#include "olfaction/identify.h"
-#include "olfaction/oe_model.h"
-#include "olfaction/signal.h"
+#include "postproc/olfaction/identify.h"
+#include "postproc/olfaction/oe_model.h"
+#include "postproc/olfaction/signal.h"
 
 using namespace naris;
 using namespace naris::olfaction;

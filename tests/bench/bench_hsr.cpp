@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "core/log.h"
-#include "image/hsr.h"
+#include "mesh/image/hsr.h"
 
 using namespace naris;
 

@@ -8,8 +8,8 @@
 #include <filesystem>
 
 #include "core/log.h"
-#include "image/interpolate_slices.h"
-#include "image/read_volume.h"
+#include "mesh/image/interpolate_slices.h"
+#include "mesh/image/read_volume.h"
 
 using namespace naris;
 

@@ -22,12 +22,12 @@
 #include <string>
 
 #include "core/log.h"
-#include "io/mesh_h5.h"
-#include "io/write_vtk.h"
-#include "mortar.h"
-#include "mve/mve.h"
-#include "quality/check.h"
-#include "quality/quality.h"
+#include "mesh/io/mesh_h5.h"
+#include "mesh/io/write_vtk.h"
+#include "tests/bench/mortar.h"
+#include "mesh/mve/mve.h"
+#include "mesh/quality/check.h"
+#include "mesh/quality/quality.h"
 
 namespace {
 
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
       for (std::size_t n = 0; n < plane; ++n)
         labels.values[plane * k + n] = labels.values[plane * k + n] > 0.0f ? 1.0f : 0.0f;
     }
-    const mve::VolumeField field(labels, mve::VolumeField::Mode::label, 1.0);
+    const mve::VolumeField field(labels, InsideRule::label, 1.0);
 
     reset_peak_memory();
     Stopwatch clock;

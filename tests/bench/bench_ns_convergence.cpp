@@ -11,9 +11,10 @@
 #include <vector>
 
 #include "core/log.h"
-#include "manufactured.h"
-#include "meshes.h"
-#include "parallel/petsc.h"
+#include "tests/solver/manufactured.h"
+#include "tests/solver/meshes.h"
+#include "solver/parallel/petsc.h"
+#include "solver/nonlinear/navier_stokes_solver.h"
 
 using namespace naris;
 
@@ -41,13 +42,15 @@ int main(int argc, char** argv) {
         const ns::BodyForce force = [nu](const Eigen::Vector3d& x) -> Eigen::Vector3d {
           return nu * testing::kBeltramiD * testing::kBeltramiD * testing::beltrami(x);
         };
-        ns::PicardReport report;
-        ns::PicardOptions options;
+        nonlinear::NonlinearReport report;
+        nonlinear::NonlinearOptions options;
         options.tolerance = 1e-9;
         Stopwatch clock;
-        const ns::FlowField f = ns::solve_navier_stokes(
-            mesh, nu, force,
-            testing::exact_on_boundary(mesh, testing::beltrami, testing::beltrami_pressure),
+        const ns::FlowField f = nonlinear::solve_navier_stokes(
+            mesh,
+            ns::FlowProblem{1.0 / nu, force,
+                            testing::exact_on_boundary(mesh, testing::beltrami,
+                                                       testing::beltrami_pressure)},
             options, &report);
         const double seconds = clock.seconds();
         const auto e = testing::l2_errors(mesh, f, testing::beltrami, testing::beltrami_pressure);

@@ -9,9 +9,9 @@
 #include <cstdlib>
 
 #include "core/log.h"
-#include "image/interpolate_slices.h"
-#include "image/phantom.h"
-#include "image/segment.h"
+#include "mesh/image/interpolate_slices.h"
+#include "mesh/image/phantom.h"
+#include "mesh/image/segment.h"
 
 using namespace naris;
 
@@ -45,8 +45,8 @@ int main(int argc, char** argv) {
                                                 phantom.seed_point()[1], phantom.seed_point()[2]),
                                     fine.frame);
       Volume<std::uint8_t> airway = m == SliceMethod::shape
-                                        ? grow_region(fine, 0.5, true, {seed})
-                                        : grow_region(fine, threshold, false, {seed});
+                                        ? grow_region(fine, 0.5, InsideRule::above, {seed})
+                                        : grow_region(fine, threshold, InsideRule::below, {seed});
       keep_largest_component(airway);
       const double seg_s = seg_clock.seconds();
       std::size_t a = 0, e = 0;

@@ -6,7 +6,7 @@
 #include <random>
 
 #include "core/log.h"
-#include "image/segment.h"
+#include "mesh/image/segment.h"
 
 using namespace naris;
 
@@ -34,12 +34,12 @@ int main() {
   clock = Stopwatch();
   const int k0 = 0;
   const Voxel seed{static_cast<int>(256 + 150 * std::cos(0.0)), 256, k0};
-  auto mask = grow_region(v, threshold, false, {seed});
+  auto mask = grow_region(v, threshold, InsideRule::below, {seed});
   const double t_grow = clock.seconds();
   std::size_t grown = 0;
   for (auto x : mask.values) grown += x;
   clock = Stopwatch();
-  auto all = threshold_mask(v, threshold, false);
+  auto all = threshold_mask(v, threshold, InsideRule::below);
   const auto summary = keep_largest_component(all);
   const double t_largest = clock.seconds();
   std::printf("%-26s %12s %10s %14s %14s %12s\n", "volume", "threshold", "grow s", "grown voxels",

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mve/mve.h"
+#include "mesh/mve/mve.h"
 
 namespace naris::bench {
 

@@ -2,7 +2,7 @@
 // Fields in memory for the mesher tests.
 #include <vector>
 
-#include "mve/mve.h"
+#include "mesh/mve/mve.h"
 
 namespace naris::testing {
 

@@ -11,8 +11,8 @@
 #include <set>
 #include <tuple>
 
-#include "mve/case_table.h"
-#include "mve/fill_component.h"
+#include "mesh/mve/case_table.h"
+#include "mesh/mve/fill_component.h"
 
 namespace naris::mve {
 namespace {

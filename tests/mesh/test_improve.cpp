@@ -4,10 +4,10 @@
 #include <cmath>
 #include <random>
 
-#include "field_helpers.h"
-#include "quality/check.h"
-#include "quality/improve.h"
-#include "quality/quality.h"
+#include "tests/mesh/field_helpers.h"
+#include "mesh/quality/check.h"
+#include "mesh/quality/improve.h"
+#include "mesh/quality/quality.h"
 
 namespace naris {
 namespace {

@@ -17,10 +17,10 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "field_helpers.h"
-#include "io/mesh_h5.h"
-#include "io/write_gmsh.h"
-#include "io/write_vtk.h"
+#include "tests/mesh/field_helpers.h"
+#include "mesh/io/mesh_h5.h"
+#include "mesh/io/write_gmsh.h"
+#include "mesh/io/write_vtk.h"
 
 namespace naris {
 namespace {

@@ -6,9 +6,9 @@
 #include <random>
 #include <set>
 
-#include "field_helpers.h"
-#include "mve/case_table.h"
-#include "quality/check.h"
+#include "tests/mesh/field_helpers.h"
+#include "mesh/mve/case_table.h"
+#include "mesh/quality/check.h"
 
 namespace naris {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-#include "pipeline/mesh_job.h"
+#include "mesh/pipeline/mesh_job.h"
 
 namespace naris {
 namespace {

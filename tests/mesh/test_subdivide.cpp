@@ -5,10 +5,10 @@
 
 #include <random>
 
-#include "field_helpers.h"
-#include "patches/patches.h"
-#include "quality/check.h"
-#include "refine/subdivide.h"
+#include "tests/mesh/field_helpers.h"
+#include "mesh/patches/patches.h"
+#include "mesh/quality/check.h"
+#include "mesh/refine/subdivide.h"
 
 namespace naris {
 namespace {

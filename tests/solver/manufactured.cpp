@@ -1,10 +1,10 @@
-#include "manufactured.h"
+#include "tests/solver/manufactured.h"
 
 #include <cmath>
 
-#include "fem/quadrature.h"
-#include "fem/reference_element.h"
-#include "meshes.h"
+#include "solver/fem/quadrature.h"
+#include "solver/fem/reference_element.h"
+#include "tests/solver/meshes.h"
 
 namespace naris::testing {
 

@@ -4,8 +4,8 @@
 // (Beltrami) flow of VERIFICATION.md §2.
 #include <functional>
 
-#include "hybrid_mesh.h"
-#include "ns/navier_stokes.h"
+#include "mesh/hybrid_mesh.h"
+#include "solver/ns/flow_field.h"
 
 namespace naris::testing {
 

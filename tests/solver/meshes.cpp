@@ -1,4 +1,4 @@
-#include "meshes.h"
+#include "tests/solver/meshes.h"
 
 #include <algorithm>
 #include <cmath>

@@ -4,8 +4,8 @@
 #include <functional>
 #include <string>
 
-#include "hybrid_mesh.h"
-#include "mve/mve.h"
+#include "mesh/hybrid_mesh.h"
+#include "mesh/mve/mve.h"
 
 namespace naris::testing {
 

@@ -1,0 +1,63 @@
+#pragma once
+// The settings tables of the stages that both a command and a case file run: interpolate,
+// segment, mesh and solve. Each holds the library's job with its defaults, the table bound to
+// it, and resolves the two into the job to run.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/settings.h"
+#include "mesh/image/image_jobs.h"
+#include "mesh/pipeline/mesh_job.h"
+#include "solver/airflow/airflow_job.h"
+
+namespace naris::app {
+
+// Relative paths in a case file are relative to the case file's folder (`base`); on the command
+// line to the working directory (`base` empty).
+std::filesystem::path resolve_path(const std::filesystem::path& base,
+                                   const std::filesystem::path& p);
+
+struct InterpolateSettings {
+  InterpolateJob job;
+  std::string method = "hsr";
+  Settings table;
+  InterpolateSettings();
+  InterpolateSettings(const InterpolateSettings&) = delete;
+  InterpolateJob resolve() const;
+};
+
+struct SegmentSettings {
+  SegmentJob job;
+  std::string inside = "below";
+  bool all_components = !job.keep_largest;
+  Settings table;
+  SegmentSettings();
+  SegmentSettings(const SegmentSettings&) = delete;
+  SegmentJob resolve() const;
+};
+
+struct MeshSettings {
+  MeshJob job;
+  std::string inside = "below";
+  bool all_components = !job.keep_largest;
+  Settings table;
+  MeshSettings();
+  MeshSettings(const MeshSettings&) = delete;
+  MeshJob resolve() const;
+};
+
+struct SolveSettings {
+  airflow::AirflowJob job;
+  std::string inlet_profile = "uniform", scheme = "coupled", petsc;
+  std::optional<std::string> restart, restart_mesh;
+  bool rebuild_preconditioner = !job.nonlinear.reuse_preconditioner;
+  bool verbose = job.nonlinear.log_iterations;
+  Settings table;
+  SolveSettings();
+  SolveSettings(const SolveSettings&) = delete;
+  airflow::AirflowJob resolve(const std::filesystem::path& base = {}) const;
+};
+
+}  // namespace naris::app

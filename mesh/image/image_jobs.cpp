@@ -1,0 +1,208 @@
+#include "mesh/image/image_jobs.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "mesh/image/read_volume.h"
+#include "mesh/image/resample.h"
+#include "mesh/image/write_volume.h"
+#include "core/atomic_file.h"
+
+namespace naris {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string dims_text(const ImageFrame& f) {
+  return fmt::format("{}×{}×{}", f.dims[0], f.dims[1], f.dims[2]);
+}
+std::string spacing_text(const ImageFrame& f) {
+  return fmt::format("{:g}×{:g}×{:g} mm", f.spacing[0], f.spacing[1], f.spacing[2]);
+}
+
+}  // namespace
+
+PhantomJobResult run_phantom_job(const PhantomJob& job) {
+  ensure_writable_folder(fs::absolute(job.output).parent_path());
+  if (!job.exact_mask.empty()) ensure_writable_folder(fs::absolute(job.exact_mask).parent_path());
+  if (!(job.mask_spacing > 0.0))
+    fail("phantom mask spacing must be positive (got {} mm)", job.mask_spacing);
+  Stopwatch clock;
+  const NasalPhantom phantom(job.subject);
+  PhantomJobResult r;
+  const Volume<float> ct = render_phantom_ct(phantom, job.sampling);
+  r.ct = ct.frame;
+  write_ct_nrrd(ct, job.output);
+  if (!job.exact_mask.empty()) {
+    ImageFrame grid = ct.frame;
+    grid.dims[2] = static_cast<int>(std::lround(phantom.length() / job.mask_spacing)) + 1;
+    grid.spacing[2] = job.mask_spacing;
+    const Volume<std::uint8_t> mask = phantom_mask(phantom, grid);
+    r.mask = grid;
+    write_labelmap_nrrd(mask, job.exact_mask);
+  }
+  r.seed = phantom.seed_point();
+  r.seconds = clock.seconds();
+  return r;
+}
+
+std::string format_phantom_summary(const PhantomJob& job, const PhantomJobResult& r) {
+  std::string s = fmt::format(
+      "naris phantom: subject {}\n  CT {} voxels of {} (coronal slices along k), noise {:g} HU\n"
+      "  seed in the naris: {:.2f},{:.2f},{:.2f} mm\n  time {:.2f} s\n  wrote {}",
+      job.subject, dims_text(r.ct), spacing_text(r.ct), job.sampling.noise, r.seed[0], r.seed[1],
+      r.seed[2], r.seconds, job.output.string());
+  if (!job.exact_mask.empty())
+    s += fmt::format("\n  wrote {} (exact airway, {} voxels of {})", job.exact_mask.string(),
+                     dims_text(r.mask), spacing_text(r.mask));
+  return s;
+}
+
+InterpolateJobResult run_interpolate_job(const InterpolateJob& job) {
+  ensure_writable_folder(fs::absolute(job.output).parent_path());
+  if (job.insert && job.spacing) fail("give the slices to insert or the target spacing, not both");
+  if (job.insert && *job.insert < 0) fail("cannot insert {} slices: give 0 or more", *job.insert);
+  if (job.spacing && !(*job.spacing > 0.0))
+    fail("the target spacing must be positive (got {} mm)", *job.spacing);
+  if (job.hsr.block < 2 || job.hsr.levels < 1 || job.hsr.iterations < 1)
+    fail("HSR needs a block of at least 2 pixels, at least one level and one iteration");
+  Stopwatch clock;
+  VolumeInfo info;
+  Volume<float> v = read_volume(job.input, &info);
+  InterpolateJobResult r;
+  r.before = v.frame;
+  if (job.axis == "auto") {
+    r.axis = static_cast<int>(std::max_element(v.frame.spacing.data(), v.frame.spacing.data() + 3) -
+                              v.frame.spacing.data());
+  } else if (job.axis == "i" || job.axis == "j" || job.axis == "k") {
+    r.axis = job.axis[0] - 'i';
+  } else {
+    fail("slice axis '{}' not understood: give i, j, k or auto", job.axis);
+  }
+  if (v.dims()[r.axis] < 2)
+    fail("{}: a single slice along {} cannot be interpolated; a volume needs at least two",
+         job.input.string(), "ijk"[r.axis]);
+  const double h = v.frame.spacing[r.axis];
+  // By default down to the finest spacing: isotropic voxels when the plane is square.
+  const double target = job.spacing ? *job.spacing : v.frame.spacing.minCoeff();
+  r.inserted =
+      job.insert ? *job.insert : std::max(0, static_cast<int>(std::lround(h / target)) - 1);
+  r.mask = is_binary(v);
+  if (job.method == SliceMethod::shape && !r.mask) {
+    // Shape-based interpolation blends distance maps of segmented slices: the gray values are
+    // segmented first at the air threshold, and the result is an airway labelmap.
+    r.binarized_at = air_threshold(v);
+    for (float& x : v.values) x = x < *r.binarized_at ? 1.0f : 0.0f;
+    r.mask = true;
+  }
+  const Volume<float> out =
+      interpolate_slices(v, r.axis, r.inserted, job.method, job.hsr, job.threads);
+  r.after = out.frame;
+  if (r.mask) {
+    write_labelmap_nrrd(to_mask(out), job.output);
+  } else {
+    write_ct_nrrd(out, job.output);
+  }
+  r.seconds = clock.seconds();
+  return r;
+}
+
+std::string format_interpolate_summary(const InterpolateJob& job, const InterpolateJobResult& r) {
+  static const char* names[] = {"hsr", "linear", "shape"};
+  std::string kind = r.mask ? "mask" : "gray values";
+  if (r.binarized_at) kind = fmt::format("gray values segmented below {:.1f} HU", *r.binarized_at);
+  return fmt::format(
+      "naris interpolate: {} ({}), method {}\n  {} → {} voxels; spacing {} → {}\n"
+      "  {} slice(s) inserted between each pair along {}\n  time {:.2f} s\n  wrote {}",
+      job.input.filename().string(), kind, names[static_cast<int>(job.method)], dims_text(r.before),
+      dims_text(r.after), spacing_text(r.before), spacing_text(r.after), r.inserted, "ijk"[r.axis],
+      r.seconds, job.output.string());
+}
+
+SegmentJobResult run_segment_job(const SegmentJob& job) {
+  ensure_writable_folder(fs::absolute(job.output).parent_path());
+  if (job.decimate < 1 || job.decimate > 16)
+    fail("decimation factor {} is not in 1 … 16", job.decimate);
+  Stopwatch clock;
+  VolumeInfo info;
+  Volume<float> ct = read_volume(job.input, &info);
+  SegmentJobResult r;
+  r.format = info.format;
+  // A labelmap (from shape-based interpolation, or a segmentation to clean up) is grown from
+  // the seeds as it is: its airway is the label 1.
+  const bool labelmap = is_binary(ct);
+  InsideRule inside = job.inside;
+  if (job.decimate > 1) ct = decimate_in_plane(ct, job.decimate);
+  if (!job.rotate.empty()) {
+    const auto colon = job.rotate.find(':');
+    const std::string axis = job.rotate.substr(0, colon);
+    if (colon == std::string::npos || (axis != "i" && axis != "j" && axis != "k"))
+      fail("rotation '{}' not understood: give AXIS:DEGREES with AXIS i, j or k", job.rotate);
+    double degrees = 0.0;
+    try {
+      degrees = std::stod(job.rotate.substr(colon + 1));
+    } catch (const std::exception&) {
+      fail("rotation '{}': the angle is not a number", job.rotate);
+    }
+    // Voxels brought in from outside the scan are the densest value: never airway.
+    ct = rotate_about_axis(ct, axis[0] - 'i', degrees, static_cast<float>(info.max_value));
+  }
+  if (job.threshold == "auto" && labelmap) {
+    r.threshold = 0.5;
+    inside = InsideRule::above;
+  } else if (job.threshold == "auto") {
+    r.threshold = air_threshold(ct);
+  } else {
+    try {
+      std::size_t used = 0;
+      r.threshold = std::stod(job.threshold, &used);
+      if (used != job.threshold.size()) throw std::invalid_argument("trailing text");
+    } catch (const std::exception&) {
+      fail("threshold '{}' is neither a number nor 'auto'", job.threshold);
+    }
+  }
+  if (!(r.threshold > info.min_value && r.threshold < info.max_value))
+    fail("{}: threshold {} is outside the data range [{}, {}]: it selects nothing or everything",
+         job.input.string(), r.threshold, info.min_value, info.max_value);
+  std::vector<Voxel> seeds;
+  for (const auto& s : job.seeds) seeds.push_back(parse_seed(s, ct.frame));
+  Volume<std::uint8_t> mask = seeds.empty() ? threshold_mask(ct, r.threshold, inside)
+                                            : grow_region(ct, r.threshold, inside, seeds);
+  std::size_t voxels = 0;
+  for (auto v : mask.values) voxels += v;
+  if (voxels == 0) fail("{}: the threshold {} selects no voxel", job.input.string(), r.threshold);
+  if (voxels == mask.values.size())
+    fail(
+        "{}: the threshold {} selects every voxel: nothing separates the airway (check the "
+        "inside side)",
+        job.input.string(), r.threshold);
+  r.components = {1, voxels, 0};
+  if (job.keep_largest) r.components = keep_largest_component(mask);
+  r.frame = mask.frame;
+  r.inside = inside;
+  r.labelmap = labelmap;
+  write_labelmap_nrrd(mask, job.output);
+  r.seconds = clock.seconds();
+  return r;
+}
+
+std::string format_segment_summary(const SegmentJob& job, const SegmentJobResult& r) {
+  const double voxel_ml = r.frame.spacing.prod() / 1000.0;
+  return fmt::format(
+      "naris segment: {} ({}, {}, {})\n  threshold {:.1f} HU ({}), inside {}\n  airway {} voxels, "
+      "{:.3f} mL; {} component(s), {} voxels dropped\n  time {:.2f} s\n  wrote {}",
+      job.input.filename().string(), dims_text(r.frame), spacing_text(r.frame), r.format,
+      r.threshold,
+      r.labelmap                ? "labelmap"
+      : job.threshold == "auto" ? "automatic"
+                                : "given",
+      inside_rule_name(r.inside), r.components.kept_voxels,
+      static_cast<double>(r.components.kept_voxels) * voxel_ml, r.components.components,
+      r.components.dropped_voxels, r.seconds, job.output.string());
+}
+
+}  // namespace naris

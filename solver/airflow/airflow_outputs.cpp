@@ -1,0 +1,347 @@
+#include "solver/airflow/airflow_outputs.h"
+
+#include <fmt/format.h>
+#include <petscsys.h>
+
+#include <algorithm>
+#include <span>
+
+#include "core/error.h"
+#include "core/json.h"
+#include "core/log.h"
+#include "core/units.h"
+#include "mesh/io/write_vtk.h"
+#include "solver/ns/wall_stress.h"
+
+namespace naris::airflow {
+namespace fs = std::filesystem;
+using ns::PatchForce;
+
+namespace {
+
+std::string profile_name(const AirflowJob& job) {
+  switch (job.profile) {
+    case ns::InletProfile::uniform:
+      return "uniform";
+    case ns::InletProfile::developed:
+      return "developed";
+    case ns::InletProfile::expression:
+      return "expression " + job.inlet_expression;
+  }
+  return {};
+}
+
+// Before a run writes its volume as `vtu` (ranks == 1) or as `pvtu` with `ranks` pieces: the
+// files of the other form, and pieces beyond the new count, from an earlier run.
+void remove_stale_volume_files(const fs::path& vtu, const fs::path& pvtu, int ranks) {
+  std::error_code ignored;  // absent is the usual case
+  if (ranks > 1)
+    fs::remove(vtu, ignored);
+  else
+    fs::remove(pvtu, ignored);
+  for (int k = ranks > 1 ? ranks : 0; fs::exists(pvtu_piece_path(pvtu, k)); ++k)
+    fs::remove(pvtu_piece_path(pvtu, k), ignored);
+}
+
+// The boundary faces of `mesh` and their nodes only, in the same face order: boundary.vtp
+// without the interior points, and what the rank that writes it keeps of the whole mesh.
+HybridMesh boundary_surface(const HybridMesh& mesh) {
+  HybridMesh s;
+  s.patch_names = mesh.patch_names;
+  std::vector<NodeId> local(mesh.nodes.size(), -1);
+  auto take = [&](const auto& faces, auto& out) {
+    for (auto f : faces) {
+      for (NodeId& v : f) {
+        auto& l = local[static_cast<std::size_t>(v)];
+        if (l < 0) {
+          l = static_cast<NodeId>(s.nodes.size());
+          s.nodes.push_back(mesh.nodes[static_cast<std::size_t>(v)]);
+        }
+        v = l;
+      }
+      out.push_back(f);
+    }
+  };
+  take(mesh.boundary_tris, s.boundary_tris);
+  take(mesh.boundary_quads, s.boundary_quads);
+  s.boundary_tri_patch = mesh.boundary_tri_patch;
+  s.boundary_quad_patch = mesh.boundary_quad_patch;
+  return s;
+}
+
+// The per-patch forces of every rank's faces, summed (the maximum shear: the largest).
+void reduce_patch_forces(std::vector<PatchForce>& patches, MPI_Comm comm) {
+  std::vector<double> sums, maxima;
+  for (const auto& p : patches) {
+    sums.insert(sums.end(), {p.area, p.mean_shear * p.area});
+    for (int c = 0; c < 3; ++c) sums.insert(sums.end(), {p.pressure[c], p.viscous[c]});
+    maxima.push_back(p.max_shear);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, sums.data(), static_cast<int>(sums.size()), MPI_DOUBLE, MPI_SUM,
+                comm);
+  MPI_Allreduce(MPI_IN_PLACE, maxima.data(), static_cast<int>(maxima.size()), MPI_DOUBLE, MPI_MAX,
+                comm);
+  for (std::size_t k = 0; k < patches.size(); ++k) {
+    const double* v = sums.data() + 8 * k;
+    auto& p = patches[k];
+    p.area = v[0];
+    p.mean_shear = p.area > 0.0 ? v[1] / p.area : 0.0;
+    for (int c = 0; c < 3; ++c) {
+      p.pressure[c] = v[2 + 2 * c];
+      p.viscous[c] = v[3 + 2 * c];
+    }
+    p.max_shear = maxima[k];
+  }
+}
+
+// The wall shear of every boundary face of the whole mesh on `root`, from the faces each rank
+// owns (`face_index`: their places in the whole mesh's order).
+std::vector<Eigen::Vector3d> gather_face_shear(const std::vector<Eigen::Vector3d>& shear,
+                                               const std::vector<std::size_t>& face_index,
+                                               std::size_t faces, MPI_Comm comm, int root) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &ranks);
+  std::vector<double> mine;  // index, then the three components, per face
+  mine.reserve(4 * shear.size());
+  for (std::size_t f = 0; f < shear.size(); ++f)
+    mine.insert(mine.end(),
+                {static_cast<double>(face_index[f]), shear[f][0], shear[f][1], shear[f][2]});
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(counts.size(), 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, root, comm);
+  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<double> all(rank == root ? 4 * faces : 0);
+  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE,
+              root, comm);
+  std::vector<Eigen::Vector3d> whole(rank == root ? faces : 0, Eigen::Vector3d::Zero());
+  for (std::size_t k = 0; k + 3 < all.size(); k += 4)
+    whole[static_cast<std::size_t>(all[k])] = {all[k + 1], all[k + 2], all[k + 3]};
+  return whole;
+}
+
+
+// The flow's numbers in SI into r; the wall stress of every boundary face (gathered on the
+// first rank), in units of ρU_in².
+ns::WallStress flow_results(const AirflowJob& job, const Partition& part,
+                            const PieceSolves& solves, const ns::FlowField& field,
+                            AirflowResult& r) {
+  const double u = r.u_in, pscale = job.density * u * u;
+  r.flow_ml_s = u * r.inlet_area_mm2;  // m/s × mm² = 1e-6 m³/s = mL/s
+  r.outlet_flow_ml_s = solves.outlet_flux(field) * u * r.d_in_mm * r.d_in_mm;
+  r.pressure_drop_pa = solves.pressure_drop(field) * pscale;
+  r.resistance = r.pressure_drop_pa / r.flow_ml_s;
+  r.max_speed = solves.max_speed(field) * u;
+  // Stresses on the boundary, while the geometry is still nondimensional.
+  ns::WallStress stress = ns::wall_stress(part.piece.mesh, field, r.reynolds);
+  int ranks = 1;
+  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
+  if (ranks > 1) {
+    reduce_patch_forces(stress.patches, PETSC_COMM_WORLD);
+    stress.shear = gather_face_shear(stress.shear, part.piece.face_index, part.boundary_faces,
+                                     PETSC_COMM_WORLD, 0);
+  }
+  const double d_in = r.d_in_mm * 1e-3, force_scale = pscale * d_in * d_in;
+  for (const auto& p : stress.patches)
+    r.patches.push_back({p.name, p.area * r.d_in_mm * r.d_in_mm, p.pressure * force_scale,
+                         p.viscous * force_scale, p.mean_shear * pscale, p.max_shear * pscale});
+  return stress;
+}
+
+// The volume: one file from a serial run; under MPI a .pvtu whose pieces the ranks write at
+// once, each its own cells. Files of the other form left by an earlier run are removed, so the
+// folder never offers two different answers.
+void write_volume(const AirflowJob& job, const Partition& part, const ns::FlowField& field,
+                  const AirflowResult& r, std::vector<std::string>& written) {
+  const double u = r.u_in, pscale = job.density * u * u;
+  PointFields fields;
+  auto vector_field = [&](double scale) {
+    PointField f{3, {}};
+    f.values.reserve(3 * field.velocity.size());
+    for (const auto& v : field.velocity)
+      for (int c = 0; c < 3; ++c) f.values.push_back(v[c] * scale);
+    return f;
+  };
+  auto scalar_field = [&](double scale) {
+    PointField f{1, {}};
+    for (double p : field.pressure) f.values.push_back(p * scale);
+    return f;
+  };
+  fields["velocity"] = vector_field(u);
+  fields["pressure"] = scalar_field(pscale);
+  fields["velocity_nondimensional"] = vector_field(1.0);
+  fields["pressure_nondimensional"] = scalar_field(1.0);
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
+  const fs::path vtu = job.output / "solution.vtu", pvtu = job.output / "solution.pvtu";
+  if (rank == 0) remove_stale_volume_files(vtu, pvtu, ranks);
+  if (ranks == 1) {
+    write_vtu(part.piece.mesh, vtu, {}, fields);
+    written.push_back(vtu.string());
+    return;
+  }
+  // A rank that cannot write its piece (disk full) must not leave the others waiting in the
+  // reductions that follow: every rank learns that one failed.
+  std::string failure;
+  try {
+    write_pvtu_piece(
+        part.piece.mesh, pvtu, rank, ranks,
+        [&](std::span<const NodeId> cell) { return part.piece.numbering.owns_cell(cell); }, {},
+        fields);
+  } catch (const Error& e) {
+    failure = e.what();
+  }
+  int failed = failure.empty() ? 0 : 1, any_failed = 0;
+  MPI_Allreduce(&failed, &any_failed, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD);
+  if (failed) fail("{}", failure);
+  if (any_failed) fail("{}: another rank could not write its piece", pvtu.string());
+  written.push_back(pvtu.string() + fmt::format(" (+ {} pieces)", ranks));
+}
+
+// boundary.vtp with the wall shear stress of every face (first rank).
+void write_boundary(const AirflowJob& job, const Partition& part, const ns::WallStress& stress,
+                    double pscale, std::vector<std::string>& written) {
+  PointFields faces;
+  PointField vec{3, {}}, mag{1, {}};
+  for (const auto& s : stress.shear) {
+    for (int c = 0; c < 3; ++c) vec.values.push_back(s[c] * pscale);
+    mag.values.push_back(s.norm() * pscale);
+  }
+  faces["wall_shear_stress"] = std::move(vec);
+  faces["wall_shear_stress_magnitude"] = std::move(mag);
+  const fs::path vtp = job.output / "boundary.vtp";
+  int ranks = 1;
+  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
+  write_boundary_vtp(ranks > 1 ? part.surface : boundary_surface(part.piece.mesh), vtp, faces);
+  written.push_back(vtp.string());
+}
+
+}  // namespace
+
+Partition partition(HybridMesh mesh, int rank, int ranks) {
+  Partition p;
+  p.counts = mesh_counts(mesh);
+  p.boundary_faces = mesh.boundary_tris.size() + mesh.boundary_quads.size();
+  if (ranks == 1) {
+    p.piece.numbering = parallel::whole_numbering(mesh.nodes.size());
+    p.piece.mesh = std::move(mesh);
+  } else {
+    p.piece = parallel::mesh_piece(mesh, rank, ranks);
+    if (rank == 0) p.surface = boundary_surface(mesh);
+  }
+  return p;
+}
+
+void write_airflow_outputs(const AirflowJob& job, Partition& part, const PieceSolves& solves,
+                           const ns::FlowField& field, AirflowResult& r) {
+  const ns::WallStress stress = flow_results(job, part, solves, field, r);
+  // Files, in millimetres again.
+  for (auto& x : part.piece.mesh.nodes) x *= r.d_in_mm;
+  for (auto& x : part.surface.nodes) x *= r.d_in_mm;
+  write_volume(job, part, field, r, r.written);
+  // Memory: the largest rank's peak is what each machine of a cluster must have, the sum what
+  // the run took in all.
+  const auto mine = static_cast<unsigned long long>(peak_memory_bytes());
+  unsigned long long largest = mine, sum = mine;
+  MPI_Allreduce(&mine, &largest, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, PETSC_COMM_WORLD);
+  MPI_Allreduce(&mine, &sum, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, PETSC_COMM_WORLD);
+  MPI_Comm_size(PETSC_COMM_WORLD, &r.ranks);
+  r.peak_memory = largest;
+  r.total_peak_memory = sum;
+  const SolutionState final_state = solves.state_at(field, r.reynolds);  // collective
+  if (!solves.writer()) return;
+  write_boundary(job, part, stress, job.density * r.u_in * r.u_in, r.written);
+  const fs::path h5 = job.output / "solution.h5";
+  write_solution_h5(final_state, h5, &part.counts, job.mesh);
+  r.written.push_back(h5.string());
+  r.written.push_back(fs::path(h5).replace_extension(".xdmf").string());
+  const fs::path csv = job.output / "residuals.csv";
+  write_residual_history(r.steps, csv);
+  r.written.push_back(csv.string());
+  // The first rank also wrote the files: its own peak may have grown since (a peak only grows).
+  const std::size_t own = peak_memory_bytes();
+  r.total_peak_memory += own - std::min<std::size_t>(own, mine);
+  r.peak_memory = std::max(r.peak_memory, own);
+}
+
+void write_summary_json(const AirflowJob& job, AirflowResult& r) {
+  Json patches = Json::array(), steps = Json::array();
+  for (const auto& p : r.patches) {
+    Json pressure = Json::array(), viscous = Json::array();
+    for (int c = 0; c < 3; ++c) {
+      pressure.push_back(significant(p.pressure_force[c]));
+      viscous.push_back(significant(p.viscous_force[c]));
+    }
+    patches.push_back({{"name", p.name},
+                       {"area_mm2", significant(p.area_mm2)},
+                       {"pressure_force_n", pressure},
+                       {"viscous_force_n", viscous},
+                       {"mean_wall_shear_pa", significant(p.mean_shear)},
+                       {"max_wall_shear_pa", significant(p.max_shear)}});
+  }
+  for (const auto& s : r.steps)
+    steps.push_back({{"reynolds", significant(s.reynolds)},
+                     {"converged", s.converged},
+                     {"arclength", s.arclength},
+                     {"nonlinear_iterations", s.iterations},
+                     {"linear_iterations", s.linear_iterations},
+                     {"preconditioner_builds", s.preconditioner_builds},
+                     {"residual", significant(s.residual, 7)},
+                     {"seconds", significant(s.seconds, 6)}});
+  const Json summary = {{"mesh", job.mesh.string()},
+                        {"cells", r.cells},
+                        {"nodes", r.nodes},
+                        {"reynolds", significant(r.reynolds)},
+                        {"inlet_speed_m_s", significant(r.u_in)},
+                        {"inlet_hydraulic_diameter_mm", significant(r.d_in_mm)},
+                        {"inlet_area_mm2", significant(r.inlet_area_mm2)},
+                        {"inlet_perimeter_mm", significant(r.inlet_perimeter_mm)},
+                        {"viscosity_m2_s", significant(job.viscosity)},
+                        {"density_kg_m3", significant(job.density)},
+                        {"inlet_profile", profile_name(job)},
+                        {"flow_ml_s", significant(r.flow_ml_s)},
+                        {"outlet_flow_ml_s", significant(r.outlet_flow_ml_s)},
+                        {"pressure_drop_pa", significant(r.pressure_drop_pa)},
+                        {"resistance_pa_s_ml", significant(r.resistance)},
+                        {"max_speed_m_s", significant(r.max_speed)},
+                        {"patches", patches},
+                        {"continuation", steps},
+                        {"mpi_ranks", r.ranks},
+                        {"seconds", significant(r.seconds)},
+                        {"peak_memory_mb", significant(megabytes(r.peak_memory), 5)},
+                        {"peak_memory_all_ranks_mb", significant(megabytes(r.total_peak_memory), 5)}};
+  const fs::path json = job.output / "summary.json";
+  write_json_file(json, summary);
+  r.written.push_back(json.string());
+  r.written.push_back((job.output / "checkpoint.h5").string());
+}
+
+std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r) {
+  AirflowResult::Patch wall;
+  for (const auto& p : r.patches)
+    if (p.name == "wall") wall = p;
+  int picard = 0;
+  for (const auto& s : r.steps) picard += s.iterations;
+  return fmt::format(
+      "naris solve: {} ({} cells, {} nodes)\n"
+      "  inlet     A {:.2f} mm², P {:.2f} mm, d_in = 4A/P {:.3f} mm; {} profile\n"
+      "  scales    Re {:.1f}, U_in {:.4f} m/s, ν {:.3g} m²/s, ρ {:.3g} kg/m³\n"
+      "  flow      {:.2f} mL/s in, {:.2f} mL/s out\n"
+      "  pressure  drop inlet→outlet {:.3f} Pa; resistance {:.4f} Pa·s/mL\n"
+      "  speed     max {:.3f} m/s\n"
+      "  wall      shear stress mean {:.4f} Pa, max {:.4f} Pa; force {:.3e} N\n"
+      "  solve     {} continuation steps, {} nonlinear steps, {:.1f} s, peak {}\n"
+      "  wrote     {}",
+      job.mesh.filename().string(), r.cells, r.nodes, r.inlet_area_mm2, r.inlet_perimeter_mm,
+      r.d_in_mm, profile_name(job), r.reynolds, r.u_in, job.viscosity, job.density, r.flow_ml_s,
+      r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance, r.max_speed, wall.mean_shear,
+      wall.max_shear, (wall.pressure_force + wall.viscous_force).norm(), r.steps.size(), picard,
+      r.seconds,
+      r.ranks > 1 ? fmt::format("{:.0f} MB per rank, {:.0f} MB on {} ranks",
+                                megabytes(r.peak_memory), megabytes(r.total_peak_memory), r.ranks)
+                  : fmt::format("{:.0f} MB", megabytes(r.peak_memory)),
+      fmt::join(r.written, "\n            "));
+}
+
+}  // namespace naris::airflow

@@ -1,0 +1,113 @@
+#include "solver/airflow/piece_solves.h"
+
+#include <fmt/format.h>
+#include <petscsys.h>
+
+#include <algorithm>
+
+#include "core/atomic_file.h"
+#include "core/csv.h"
+#include "solver/nonlinear/bordered_step.h"
+#include "solver/nonlinear/navier_stokes_solver.h"
+#include "solver/ns/distributed_field.h"
+#include "solver/ns/patch_integrals.h"
+
+namespace naris::airflow {
+
+PieceSolves::PieceSolves(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
+                         ns::FlowProblem problem, int inlet, int outlet, SolutionScales scales,
+                         RunFiles files)
+    : piece_(piece),
+      numbering_(numbering),
+      problem_(std::move(problem)),
+      inlet_(inlet),
+      outlet_(outlet),
+      scales_(scales),
+      files_(std::move(files)) {
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank_);
+}
+
+ns::FlowField PieceSolves::solve(double reynolds, const nonlinear::NonlinearOptions& options,
+                                 const ns::FlowField* initial,
+                                 const nonlinear::ArclengthConstraint* constraint,
+                                 nonlinear::NonlinearReport& report) {
+  problem_.reynolds = reynolds;
+  return nonlinear::solve_navier_stokes(piece_, numbering_, problem_, options, &report, initial,
+                                        constraint);
+}
+
+double PieceSolves::inner_product(const ns::FlowField& a, const ns::FlowField& b) {
+  return nonlinear::velocity_inner_product(a, b, numbering_, PETSC_COMM_WORLD);
+}
+
+SolutionState PieceSolves::state_at(const ns::FlowField& field, double reynolds) const {
+  SolutionState s;
+  s.field = ns::gather_field(field, numbering_, PETSC_COMM_WORLD, 0);
+  s.reynolds = reynolds;
+  s.target_reynolds = scales_.target_reynolds;
+  s.u_in = scales_.u_in;
+  s.d_in_mm = scales_.d_in_mm;
+  s.density = scales_.density;
+  s.viscosity = scales_.viscosity;
+  s.mesh_fingerprint = scales_.mesh_fingerprint;
+  return s;
+}
+
+void PieceSolves::checkpoint(double reynolds, const ns::FlowField& field,
+                             const continuation::ContinuationState& state) {
+  SolutionState s = state_at(field, reynolds);  // collective
+  s.continuation = state;
+  if (state.earlier_reynolds > 0.0)
+    s.continuation.earlier = ns::gather_field(state.earlier, numbering_, PETSC_COMM_WORLD, 0);
+  if (writer()) write_solution_h5(s, files_.checkpoint);
+}
+
+void PieceSolves::branch_point(double reynolds, const ns::FlowField& f, int newton_steps,
+                               double arclength) {
+  const double u = scales_.u_in * reynolds / scales_.target_reynolds;  // U_in at that Re, m/s
+  branch_rows_ += fmt::format("{:.6f},{:.6e},{:.6f},{:.6f},{}\n", reynolds, arclength,
+                              pressure_drop(f) * scales_.density * u * u, max_speed(f) * u,
+                              newton_steps);
+  if (!writer()) return;
+  write_text_file(files_.branch,
+                  "reynolds,arclength,pressure_drop_pa,max_speed_m_s,newton_steps\n" + branch_rows_);
+}
+
+void PieceSolves::giving_up(const std::vector<continuation::ContinuationStep>& steps) {
+  if (writer()) write_residual_history(steps, files_.residuals);
+}
+
+double PieceSolves::pressure_drop(const ns::FlowField& f) const {
+  const ns::PatchIntegral in = ns::patch_integral(piece_, f.pressure, inlet_),
+                          out = ns::patch_integral(piece_, f.pressure, outlet_);
+  double sums[4] = {in.integral, in.area, out.integral, out.area};
+  MPI_Allreduce(MPI_IN_PLACE, sums, 4, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+  return sums[0] / sums[1] - sums[2] / sums[3];
+}
+
+double PieceSolves::max_speed(const ns::FlowField& f) const {
+  double m = 0.0;
+  for (NodeId k = 0; k < numbering_.owned; ++k)
+    m = std::max(m, f.velocity[static_cast<std::size_t>(k)].norm());
+  MPI_Allreduce(MPI_IN_PLACE, &m, 1, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
+  return m;
+}
+
+double PieceSolves::outlet_flux(const ns::FlowField& f) const {
+  double flux = ns::patch_flux(piece_, f.velocity, outlet_);
+  MPI_Allreduce(MPI_IN_PLACE, &flux, 1, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+  return flux;
+}
+
+void write_residual_history(const std::vector<continuation::ContinuationStep>& steps,
+                            const std::filesystem::path& path) {
+  CsvTable table({"step", "reynolds", "converged", "iteration", "residual"});
+  for (std::size_t s = 0; s < steps.size(); ++s)
+    for (std::size_t i = 0; i < steps[s].residuals.size(); ++i)
+      table.add_row({std::to_string(s), fmt::format("{:g}", steps[s].reynolds),
+                     steps[s].converged ? "1" : "0", std::to_string(i),
+                     fmt::format("{:.6e}", steps[s].residuals[i])});
+  table.write(path);
+}
+
+}  // namespace naris::airflow

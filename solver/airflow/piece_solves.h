@@ -1,0 +1,67 @@
+#pragma once
+// The discrete problem on this rank's piece of the mesh as the Reynolds continuation sees it:
+// each solve shared by the ranks, checkpoints and the branch's points gathered on the first.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "solver/airflow/solution_file.h"
+#include "solver/continuation/reynolds_continuation.h"
+#include "solver/ns/flow_problem.h"
+#include "solver/parallel/partition.h"
+
+namespace naris::airflow {
+
+// What every solution file of the run carries besides its field.
+struct SolutionScales {
+  double target_reynolds = 0.0, u_in = 0.0, d_in_mm = 0.0, density = 0.0, viscosity = 0.0;
+  std::uint64_t mesh_fingerprint = 0;
+};
+
+struct RunFiles {
+  std::filesystem::path checkpoint, branch, residuals;
+};
+
+class PieceSolves final : public continuation::SteadySolves {
+ public:
+  // `problem` holds the piece's conditions; its Reynolds number is set for each solve.
+  PieceSolves(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
+              ns::FlowProblem problem, int inlet, int outlet, SolutionScales scales,
+              RunFiles files);
+
+  ns::FlowField solve(double reynolds, const nonlinear::NonlinearOptions& options,
+                      const ns::FlowField* initial,
+                      const nonlinear::ArclengthConstraint* constraint,
+                      nonlinear::NonlinearReport& report) override;
+  double inner_product(const ns::FlowField& a, const ns::FlowField& b) override;
+  void checkpoint(double reynolds, const ns::FlowField& field,
+                  const continuation::ContinuationState& state) override;
+  void branch_point(double reynolds, const ns::FlowField& field, int newton_steps,
+                    double arclength) override;
+  void giving_up(const std::vector<continuation::ContinuationStep>& steps) override;
+
+  // Nondimensional, collective: the inlet→outlet drop of the area-averaged pressure, the
+  // largest speed, and the flux out through the outlet.
+  double pressure_drop(const ns::FlowField& f) const;
+  double max_speed(const ns::FlowField& f) const;
+  double outlet_flux(const ns::FlowField& f) const;
+  // The state at `reynolds` on the first rank (the others get an empty field). Collective.
+  SolutionState state_at(const ns::FlowField& field, double reynolds) const;
+  bool writer() const { return rank_ == 0; }
+
+ private:
+  const HybridMesh& piece_;
+  const parallel::NodeNumbering& numbering_;
+  ns::FlowProblem problem_;
+  int inlet_, outlet_;
+  SolutionScales scales_;
+  RunFiles files_;
+  int rank_ = 0;
+  std::string branch_rows_;
+};
+
+// residuals.csv: every nonlinear residual of every step, converged or not.
+void write_residual_history(const std::vector<continuation::ContinuationStep>& steps,
+                            const std::filesystem::path& path);
+
+}  // namespace naris::airflow
