@@ -7,10 +7,10 @@
 #include <memory>
 
 #include "app/commands.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "postproc/figures/line_plot.h"
-#include "core/atomic_file.h"
 #include "postproc/olfaction/identify.h"
 #include "postproc/olfaction/model_io.h"
 #include "postproc/olfaction/oe_model.h"

@@ -1,6 +1,6 @@
 // `naris run case.yaml`: the stages of a case, from the CT (or the phantom) to the flow, one
-// file (or folder) each. A stage is skipped when its outputs are newer than its inputs and its settings are
-// the ones it last ran with (kept in <output>/.naris-run/); `--force` runs everything.
+// file (or folder) each. A stage is skipped when its outputs are newer than its inputs and its
+// settings are the ones it last ran with (kept in <output>/.naris-run/); `--force` runs everything.
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
@@ -14,23 +14,27 @@
 
 #include "app/commands.h"
 #include "app/stage_settings.h"
-#include "solver/parallel/petsc.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "mesh/image/image_jobs.h"
 #include "mesh/image/phantom.h"
 #include "mesh/image/read_volume.h"
-#include "core/atomic_file.h"
-#include "mesh/image/image_jobs.h"
 #include "mesh/pipeline/mesh_job.h"
+#include "solver/parallel/petsc.h"
 
 namespace naris::app {
 namespace fs = std::filesystem;
 
 namespace {
 
-bool present(const YAML::Node& node) { return node && !node.IsNull(); }
+bool present(const YAML::Node& node) {
+  return node && !node.IsNull();
+}
 // A section's settings as text: a stage reruns when they change.
-std::string dump(const YAML::Node& node) { return present(node) ? YAML::Dump(node) : ""; }
+std::string dump(const YAML::Node& node) {
+  return present(node) ? YAML::Dump(node) : "";
+}
 
 // A case-file section of the phantom and the top level read strictly: every key must be known,
 // every value of the right type.
@@ -212,11 +216,15 @@ void run_case(const RunOptions& o) {
     job->mesh = mesh_file;
     job->output = out / "solution";
     const std::string petsc_options = settings->petsc;
-    stages.push_back({"solve", {job->mesh}, {job->output / "summary.json"}, dump(root["solve"]),
+    stages.push_back({"solve",
+                      {job->mesh},
+                      {job->output / "summary.json"},
+                      dump(root["solve"]),
                       [job, petsc_options] {
                         petsc::Session session;
                         insert_petsc_options(petsc_options);
-                        return airflow::format_airflow_summary(*job, airflow::run_airflow_job(*job));
+                        return airflow::format_airflow_summary(*job,
+                                                               airflow::run_airflow_job(*job));
                       }});
   }
 

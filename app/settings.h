@@ -3,9 +3,9 @@
 // (--name, dashes for underscores) and its section of a case file (name: value), with the same
 // names, defaults, help and checks. A boolean that defaults to true is switched off on the
 // command line by --no-name; one that defaults to false is switched on by --name.
-#include <CLI/CLI.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include <CLI/CLI.hpp>
 #include <functional>
 #include <memory>
 #include <optional>

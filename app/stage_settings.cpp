@@ -184,8 +184,8 @@ airflow::AirflowJob SolveSettings::resolve(const std::filesystem::path& base) co
   j.nonlinear.reuse_preconditioner = !rebuild_preconditioner;
   j.nonlinear.log_iterations = verbose;
   j.profile = table.given("inlet_expression") ? ns::InletProfile::expression
-              : inlet_profile == "developed"   ? ns::InletProfile::developed
-                                               : ns::InletProfile::uniform;
+              : inlet_profile == "developed"  ? ns::InletProfile::developed
+                                              : ns::InletProfile::uniform;
   if (restart) j.restart = resolve_path(base, *restart);
   if (restart_mesh) j.restart_mesh = resolve_path(base, *restart_mesh);
   return j;

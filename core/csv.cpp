@@ -18,6 +18,8 @@ void CsvTable::add_row(std::vector<std::string> fields) {
   ++rows_;
 }
 
-void CsvTable::write(const std::filesystem::path& path) const { write_text_file(path, text_); }
+void CsvTable::write(const std::filesystem::path& path) const {
+  write_text_file(path, text_);
+}
 
 }  // namespace naris

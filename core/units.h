@@ -4,6 +4,8 @@
 
 namespace naris {
 
-inline double megabytes(std::size_t bytes) { return static_cast<double>(bytes) / 1048576.0; }
+inline double megabytes(std::size_t bytes) {
+  return static_cast<double>(bytes) / 1048576.0;
+}
 
 }  // namespace naris

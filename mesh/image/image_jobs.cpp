@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "mesh/image/read_volume.h"
 #include "mesh/image/resample.h"
 #include "mesh/image/write_volume.h"
-#include "core/atomic_file.h"
 
 namespace naris {
 namespace fs = std::filesystem;

@@ -52,7 +52,7 @@ std::string format_interpolate_summary(const InterpolateJob& job, const Interpol
 
 struct SegmentJob {
   std::filesystem::path input, output = "airway.nrrd";
-  std::string threshold = "auto";  // HU, or auto: the histogram valley nearest −1000
+  std::string threshold = "auto";         // HU, or auto: the histogram valley nearest −1000
   InsideRule inside = InsideRule::below;  // the threshold's side
   std::vector<std::string> seeds;  // "i,j,k" or "x,y,z mm"; none: every voxel past the threshold
   bool keep_largest = true;

@@ -30,7 +30,7 @@ inline InsideRule parse_threshold_side(const std::string& side) {
 
 // Whether `value` is inside by `rule` at `level`.
 inline bool is_inside(InsideRule rule, double value, double level) {
-  return rule == InsideRule::label ? value == level
+  return rule == InsideRule::label   ? value == level
          : rule == InsideRule::above ? value > level
                                      : value < level;
 }

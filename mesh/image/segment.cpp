@@ -162,8 +162,7 @@ Volume<std::uint8_t> grow_region(const Volume<float>& image, double threshold, I
   return mask;
 }
 
-Volume<std::uint8_t> threshold_mask(const Volume<float>& image, double threshold,
-                                    InsideRule side) {
+Volume<std::uint8_t> threshold_mask(const Volume<float>& image, double threshold, InsideRule side) {
   const bool inside_above = above(side);
   Volume<std::uint8_t> mask;
   mask.frame = image.frame;

@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <memory>
 
-#include "core/error.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
 
 namespace naris {
 

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <set>
 
-#include "core/error.h"
-#include "core/log.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/json.h"
+#include "core/log.h"
 #include "core/units.h"
 #include "mesh/io/mesh_h5.h"
 #include "mesh/io/write_gmsh.h"
@@ -51,8 +51,7 @@ mve::VolumeField make_field(const Volume<float>& volume, const MeshJob& job, Mes
     level = 1.0;
   }
   std::size_t inside = 0;
-  for (float v : volume.values)
-    inside += is_inside(mode, v, level);
+  for (float v : volume.values) inside += is_inside(mode, v, level);
   if (inside == 0) {
     if (mode == InsideRule::label) {
       std::set<float> present;
@@ -82,11 +81,16 @@ Json quality_json(const QualityReport& q) {
     Json group = Json::object();
     for (std::size_t m = 0; m < kMetrics.size(); ++m) {
       const auto& st = q.summary[g][m];
-      group[metric_name(kMetrics[m])] = {
-          {"count", st.count},        {"min", significant(st.min)}, {"p1", significant(st.p1)},
-          {"p5", significant(st.p5)}, {"p50", significant(st.p50)}, {"p95", significant(st.p95)},
-          {"p99", significant(st.p99)}, {"max", significant(st.max)},
-          {"histogram_range", {st.lo, st.hi}}, {"histogram", st.histogram}};
+      group[metric_name(kMetrics[m])] = {{"count", st.count},
+                                         {"min", significant(st.min)},
+                                         {"p1", significant(st.p1)},
+                                         {"p5", significant(st.p5)},
+                                         {"p50", significant(st.p50)},
+                                         {"p95", significant(st.p95)},
+                                         {"p99", significant(st.p99)},
+                                         {"max", significant(st.max)},
+                                         {"histogram_range", {st.lo, st.hi}},
+                                         {"histogram", st.histogram}};
     }
     out[q.groups[g]] = std::move(group);
   }
@@ -195,7 +199,8 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
       {"level", r.level},
       {"nodes", r.mesh.nodes.size()},
       {"cells",
-       {{"tet", r.mesh.tets.size()}, {"pyramid", r.mesh.pyramids.size()},
+       {{"tet", r.mesh.tets.size()},
+        {"pyramid", r.mesh.pyramids.size()},
         {"hex", r.mesh.hexes.size()}}},
       {"boundary_faces",
        {{"tri", r.mesh.boundary_tris.size()}, {"quad", r.mesh.boundary_quads.size()}}},
@@ -226,7 +231,7 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
       "  nodes     {}\n  volume    {:.1f} mm³ ({:.3f} mL)\n",
       job.input.filename().string(), r.input.format,
       r.rule == InsideRule::label ? fmt::format("label {}", r.level)
-                        : fmt::format("inside {} {}", inside_rule_name(r.rule), r.level),
+                                  : fmt::format("inside {} {}", inside_rule_name(r.rule), r.level),
       m.cell_count(), m.hexes.size(), m.pyramids.size(), m.tets.size(), m.nodes.size(),
       mesh_volume(m), mesh_volume(m) / 1000.0);
   if (r.mve.dropped_components)

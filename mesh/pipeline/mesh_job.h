@@ -19,8 +19,8 @@ namespace naris {
 
 struct MeshJob {
   std::filesystem::path input;
-  std::optional<double> threshold;  // inside is below it by default (air in CT)
-  std::optional<double> label;      // inside is exactly this value
+  std::optional<double> threshold;        // inside is below it by default (air in CT)
+  std::optional<double> label;            // inside is exactly this value
   InsideRule inside = InsideRule::below;  // with a threshold: its side (below or above)
   std::optional<std::string> inlet, outlet;
   std::vector<std::string> regions;  // name:box=... or name:sphere=...
@@ -38,7 +38,7 @@ struct MeshJob {
 struct MeshJobResult {
   HybridMesh mesh;
   VolumeInfo input;
-  double level = 0.0;  // the threshold or label used
+  double level = 0.0;                   // the threshold or label used
   InsideRule rule = InsideRule::label;  // what inside meant
   mve::MveStats mve;
   ImproveStats improvement;

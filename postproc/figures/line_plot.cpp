@@ -7,8 +7,8 @@
 #include <cmath>
 #include <memory>
 
-#include "core/error.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
 
 namespace naris::figures {
 namespace {

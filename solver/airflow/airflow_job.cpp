@@ -136,8 +136,7 @@ std::optional<SolutionState> read_restart(const AirflowJob& job, const AirflowMe
   return resume;
 }
 
-continuation::ContinuationSettings continuation_settings(const AirflowJob& job,
-                                                         double target) {
+continuation::ContinuationSettings continuation_settings(const AirflowJob& job, double target) {
   continuation::ContinuationSettings s;
   s.target = target;
   s.start = job.start_reynolds;
@@ -176,12 +175,11 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   problem.conditions = ns::local_conditions(m.conditions, part.piece.numbering);
   problem.backflow.patch = m.outlet;
   problem.backflow.beta = 1.0;
-  const SolutionScales scales{r.reynolds,     r.u_in,        r.d_in_mm,
-                              job.density,    job.viscosity, m.fingerprint};
-  PieceSolves solves(part.piece.mesh, part.piece.numbering, std::move(problem), m.inlet,
-                     m.outlet, scales,
-                     {job.output / "checkpoint.h5", job.output / "branch.csv",
-                      job.output / "residuals.csv"});
+  const SolutionScales scales{r.reynolds,  r.u_in,        r.d_in_mm,
+                              job.density, job.viscosity, m.fingerprint};
+  PieceSolves solves(
+      part.piece.mesh, part.piece.numbering, std::move(problem), m.inlet, m.outlet, scales,
+      {job.output / "checkpoint.h5", job.output / "branch.csv", job.output / "residuals.csv"});
 
   continuation::ReynoldsContinuation continuation(continuation_settings(job, r.reynolds), solves);
   if (resume) {

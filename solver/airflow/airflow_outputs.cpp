@@ -120,12 +120,10 @@ std::vector<Eigen::Vector3d> gather_face_shear(const std::vector<Eigen::Vector3d
   return whole;
 }
 
-
 // The flow's numbers in SI into r; the wall stress of every boundary face (gathered on the
 // first rank), in units of ρU_in².
-ns::WallStress flow_results(const AirflowJob& job, const Partition& part,
-                            const PieceSolves& solves, const ns::FlowField& field,
-                            AirflowResult& r) {
+ns::WallStress flow_results(const AirflowJob& job, const Partition& part, const PieceSolves& solves,
+                            const ns::FlowField& field, AirflowResult& r) {
   const double u = r.u_in, pscale = job.density * u * u;
   r.flow_ml_s = u * r.inlet_area_mm2;  // m/s × mm² = 1e-6 m³/s = mL/s
   r.outlet_flow_ml_s = solves.outlet_flux(field) * u * r.d_in_mm * r.d_in_mm;
@@ -289,28 +287,29 @@ void write_summary_json(const AirflowJob& job, AirflowResult& r) {
                      {"preconditioner_builds", s.preconditioner_builds},
                      {"residual", significant(s.residual, 7)},
                      {"seconds", significant(s.seconds, 6)}});
-  const Json summary = {{"mesh", job.mesh.string()},
-                        {"cells", r.cells},
-                        {"nodes", r.nodes},
-                        {"reynolds", significant(r.reynolds)},
-                        {"inlet_speed_m_s", significant(r.u_in)},
-                        {"inlet_hydraulic_diameter_mm", significant(r.d_in_mm)},
-                        {"inlet_area_mm2", significant(r.inlet_area_mm2)},
-                        {"inlet_perimeter_mm", significant(r.inlet_perimeter_mm)},
-                        {"viscosity_m2_s", significant(job.viscosity)},
-                        {"density_kg_m3", significant(job.density)},
-                        {"inlet_profile", profile_name(job)},
-                        {"flow_ml_s", significant(r.flow_ml_s)},
-                        {"outlet_flow_ml_s", significant(r.outlet_flow_ml_s)},
-                        {"pressure_drop_pa", significant(r.pressure_drop_pa)},
-                        {"resistance_pa_s_ml", significant(r.resistance)},
-                        {"max_speed_m_s", significant(r.max_speed)},
-                        {"patches", patches},
-                        {"continuation", steps},
-                        {"mpi_ranks", r.ranks},
-                        {"seconds", significant(r.seconds)},
-                        {"peak_memory_mb", significant(megabytes(r.peak_memory), 5)},
-                        {"peak_memory_all_ranks_mb", significant(megabytes(r.total_peak_memory), 5)}};
+  const Json summary = {
+      {"mesh", job.mesh.string()},
+      {"cells", r.cells},
+      {"nodes", r.nodes},
+      {"reynolds", significant(r.reynolds)},
+      {"inlet_speed_m_s", significant(r.u_in)},
+      {"inlet_hydraulic_diameter_mm", significant(r.d_in_mm)},
+      {"inlet_area_mm2", significant(r.inlet_area_mm2)},
+      {"inlet_perimeter_mm", significant(r.inlet_perimeter_mm)},
+      {"viscosity_m2_s", significant(job.viscosity)},
+      {"density_kg_m3", significant(job.density)},
+      {"inlet_profile", profile_name(job)},
+      {"flow_ml_s", significant(r.flow_ml_s)},
+      {"outlet_flow_ml_s", significant(r.outlet_flow_ml_s)},
+      {"pressure_drop_pa", significant(r.pressure_drop_pa)},
+      {"resistance_pa_s_ml", significant(r.resistance)},
+      {"max_speed_m_s", significant(r.max_speed)},
+      {"patches", patches},
+      {"continuation", steps},
+      {"mpi_ranks", r.ranks},
+      {"seconds", significant(r.seconds)},
+      {"peak_memory_mb", significant(megabytes(r.peak_memory), 5)},
+      {"peak_memory_all_ranks_mb", significant(megabytes(r.total_peak_memory), 5)}};
   const fs::path json = job.output / "summary.json";
   write_json_file(json, summary);
   r.written.push_back(json.string());

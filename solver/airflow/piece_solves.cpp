@@ -65,12 +65,13 @@ void PieceSolves::checkpoint(double reynolds, const ns::FlowField& field,
 void PieceSolves::branch_point(double reynolds, const ns::FlowField& f, int newton_steps,
                                double arclength) {
   const double u = scales_.u_in * reynolds / scales_.target_reynolds;  // U_in at that Re, m/s
-  branch_rows_ += fmt::format("{:.6f},{:.6e},{:.6f},{:.6f},{}\n", reynolds, arclength,
-                              pressure_drop(f) * scales_.density * u * u, max_speed(f) * u,
-                              newton_steps);
+  branch_rows_ +=
+      fmt::format("{:.6f},{:.6e},{:.6f},{:.6f},{}\n", reynolds, arclength,
+                  pressure_drop(f) * scales_.density * u * u, max_speed(f) * u, newton_steps);
   if (!writer()) return;
-  write_text_file(files_.branch,
-                  "reynolds,arclength,pressure_drop_pa,max_speed_m_s,newton_steps\n" + branch_rows_);
+  write_text_file(
+      files_.branch,
+      "reynolds,arclength,pressure_drop_pa,max_speed_m_s,newton_steps\n" + branch_rows_);
 }
 
 void PieceSolves::giving_up(const std::vector<continuation::ContinuationStep>& steps) {

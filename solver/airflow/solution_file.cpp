@@ -5,8 +5,8 @@
 #include <sstream>
 #include <vector>
 
-#include "core/error.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/hdf5_table.h"
 
 namespace naris::airflow {

@@ -308,8 +308,7 @@ bool ReynoldsContinuation::follow_branch(double ds) {
       "the continuation stalled at Re {:.1f} (target {:.1f}); following the steady branch from "
       "there by arclength, {}, and it stayed between Re {:.1f} and {:.1f} ({} holds it, {} its "
       "last point)",
-      re_first, settings_.target, turned, lowest, highest, settings_.branch,
-      settings_.checkpoint));
+      re_first, settings_.target, turned, lowest, highest, settings_.branch, settings_.checkpoint));
 }
 
 // Past the target: the target itself, from the chord between the last point and `found`.
@@ -323,9 +322,9 @@ bool ReynoldsContinuation::converge_at_target(const FlowField& found, double re_
   NonlinearOptions exact = o;
   exact.tolerance = settings_.nonlinear.tolerance;
   FlowField at_target = solve_step(last, target, exact, &start, nullptr);
-  log_line(fmt::format("  Re {:8.1f}: {} after {} Newton steps, residual {:.2e}, {:.1f} s",
-                       target, last.converged ? "converged" : "FAILED", last.iterations,
-                       last.residual, last.seconds));
+  log_line(fmt::format("  Re {:8.1f}: {} after {} Newton steps, residual {:.2e}, {:.1f} s", target,
+                       last.converged ? "converged" : "FAILED", last.iterations, last.residual,
+                       last.seconds));
   if (!last.converged) return false;
   earlier_ = std::move(last_good_);
   earlier_re_ = reached_;

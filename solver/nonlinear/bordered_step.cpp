@@ -75,8 +75,7 @@ bool BorderedStep::on_constraint(const ns::FlowField& field, double reynolds) co
 }
 
 double BorderedStep::correct(LinearSolver& linear, const ns::FlowField& field, double reynolds,
-                             double eta, bool newton, LinearSolve& solve,
-                             NonlinearReport& report) {
+                             double eta, bool newton, LinearSolve& solve, NonlinearReport& report) {
   check(VecAXPBY(system_.rhs(), -1.0, 0.0, sensitivity_), "VecAXPBY");
   const LinearSolve second = linear.solve_again(system_.rhs(), sensitivity_solution_, eta);
   // b = du/dRe only with Newton's derivative; after a Picard step it is not the tangent.
@@ -97,8 +96,7 @@ double BorderedStep::correct(LinearSolver& linear, const ns::FlowField& field, d
 // The tangent from b = du/dRe (J b = −∂R/∂Re), not from the secant through two points: points
 // converged to a loose tolerance carry errors as large as a short step, and the secant through
 // them can reverse and claim a turn that is not there.
-void BorderedStep::report_tangent(const ns::FlowField& field, double reynolds,
-                                  NonlinearReport& r) {
+void BorderedStep::report_tangent(const ns::FlowField& field, double reynolds, NonlinearReport& r) {
   if (!tangent_known_) return;
   r.tangent = field;
   system_.gather(sensitivity_solution_, r.tangent);

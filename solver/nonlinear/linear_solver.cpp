@@ -17,8 +17,7 @@ LinearSolver::LinearSolver(MPI_Comm comm, const NonlinearOptions& options,
       progress_{Stopwatch(), options.progress_seconds},
       // Any preconditioner of the coupled system may be kept; the segregated sweeps set theirs
       // up themselves.
-      reuse_(options.reuse_preconditioner &&
-             options.scheme == NonlinearOptions::Scheme::coupled) {
+      reuse_(options.reuse_preconditioner && options.scheme == NonlinearOptions::Scheme::coupled) {
   check(KSPCreate(comm, ksp_.out()), "KSPCreate");
   check(KSPSetOptionsPrefix(ksp_, options.options_prefix.c_str()), "KSPSetOptionsPrefix");
   // Each solve is inexact: it stops when the residual of the correction equation has fallen by
@@ -91,17 +90,17 @@ PetscErrorCode LinearSolver::monitor(KSP solver, PetscInt it, PetscReal norm, vo
 LinearSolve LinearSolver::solve(LinearProblem kind, Mat op, Mat matrix, Vec b, Vec delta,
                                 double eta, NonlinearReport& report) {
   LinearSolve out;
-  PetscInt its = 0, abandoned = 0;  // abandoned: those of a kept preconditioner's try
+  PetscInt its = 0, abandoned = 0;          // abandoned: those of a kept preconditioner's try
   const double decades = -std::log10(eta);  // the reduction asked for
   bool rebuilt = false;
   for (bool rebuild = !reuse_.keeps(kind);; rebuild = true) {
     check(KSPSetOperators(ksp_, op, matrix), "KSPSetOperators");
     check(KSPSetReusePreconditioner(ksp_, rebuild ? PETSC_FALSE : PETSC_TRUE),
           "KSPSetReusePreconditioner");
-    check(KSPSetTolerances(ksp_, eta, PETSC_DEFAULT, PETSC_DEFAULT,
-                           rebuild ? max_iterations_
-                                   : std::min<PetscInt>(max_iterations_,
-                                                        reuse_.iteration_budget(decades))),
+    check(KSPSetTolerances(
+              ksp_, eta, PETSC_DEFAULT, PETSC_DEFAULT,
+              rebuild ? max_iterations_
+                      : std::min<PetscInt>(max_iterations_, reuse_.iteration_budget(decades))),
           "KSPSetTolerances");
     // The work of the factorization and of the solve in floating-point operations as PETSc
     // counts them, not in seconds: the counts are the same on every run, so whether a

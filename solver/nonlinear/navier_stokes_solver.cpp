@@ -20,8 +20,8 @@
 namespace naris::nonlinear {
 namespace {
 
-using petsc::check;
 using ns::FlowField;
+using petsc::check;
 using Scheme = NonlinearOptions::Scheme;
 
 MPI_Comm communicator_of(const ns::FlowProblem& problem) {
@@ -69,8 +69,8 @@ class NavierStokesSolver {
 
   FlowField solve(NonlinearReport& r) {
     r = {};
-    for (int it = 0;
-         solves_ <= options_.max_iterations + 1 && it < 4 * options_.max_iterations + 8; ++it) {
+    for (int it = 0; solves_ <= options_.max_iterations + 1 && it < 4 * options_.max_iterations + 8;
+         ++it) {
       const Next next = step(r);
       if (next == Next::stop) break;
     }
@@ -103,7 +103,7 @@ class NavierStokesSolver {
     system_.distribute(field_, current_);
     const bool newton = !stokes_ && options_.newton && options_.scheme != Scheme::segregated &&
                         picard_run_ >= options_.picard_steps;
-    const auto linearization = stokes_ ? ns::Linearization::picard
+    const auto linearization = stokes_  ? ns::Linearization::picard
                                : newton ? ns::Linearization::newton
                                         : ns::Linearization::picard_residual;
     if (bordered_) bordered_->sample_residual_above(field_, reynolds_, problem_.force);
@@ -151,7 +151,8 @@ class NavierStokesSolver {
     check(VecAYPX(system_.solution(), 1.0, current_), "VecAYPX");
     ++solves_;
     log_step(newton, linear.description, reynolds_step);
-    if (linear.reason < 0) fail("the linear solver failed ({})", KSPConvergedReasons[linear.reason]);
+    if (linear.reason < 0)
+      fail("the linear solver failed ({})", KSPConvergedReasons[linear.reason]);
     take_step(newton, reynolds_step, r);
     return Next::go_on;
   }
@@ -317,8 +318,8 @@ FlowField solve_navier_stokes(const HybridMesh& mesh, const ns::FlowProblem& pro
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &ranks);
   if (ranks == 1)
-    return solve_navier_stokes(mesh, parallel::whole_numbering(mesh.nodes.size()), problem,
-                               options, report, initial);
+    return solve_navier_stokes(mesh, parallel::whole_numbering(mesh.nodes.size()), problem, options,
+                               report, initial);
   const parallel::MeshPiece piece = parallel::mesh_piece(mesh, rank, ranks);
   std::optional<FlowField> start;
   if (initial) start = ns::local_field(*initial, piece.numbering);

@@ -19,8 +19,7 @@ namespace naris::nonlinear {
 // With `arclength` the Reynolds number is an unknown too (Newton steps only, no pseudo-time):
 // problem.reynolds is the predictor's, `initial` the predicted field, and report->reynolds the
 // Re found.
-ns::FlowField solve_navier_stokes(const HybridMesh& piece,
-                                  const parallel::NodeNumbering& numbering,
+ns::FlowField solve_navier_stokes(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
                                   const ns::FlowProblem& problem, const NonlinearOptions& options,
                                   NonlinearReport* report = nullptr,
                                   const ns::FlowField* initial = nullptr,

@@ -13,8 +13,8 @@ namespace naris::nonlinear {
 // is the damping.
 class StepDamping {
  public:
-  StepDamping(double largest, bool backtracking) : largest_(largest), omega_(largest),
-                                                   backtracking_(backtracking) {}
+  StepDamping(double largest, bool backtracking)
+      : largest_(largest), omega_(largest), backtracking_(backtracking) {}
   double omega() const { return omega_; }
   // Whether the step that led from residual `previous` to `norm` is to be retaken shorter (ω is
   // then halved); `retakeable`: there is an iterate to retake it from.

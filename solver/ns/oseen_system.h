@@ -67,8 +67,9 @@ class OseenSystem {
     std::vector<PetscInt> blocks(static_cast<std::size_t>(nodes));
     for (NodeId k = 0; k < nodes; ++k) blocks[static_cast<std::size_t>(k)] = numbering.to_global(k);
     petsc::IndexSet from;
-    petsc::check(ISCreateBlock(PETSC_COMM_SELF, 4, nodes, blocks.data(), PETSC_COPY_VALUES, from.out()),
-          "ISCreateBlock");
+    petsc::check(
+        ISCreateBlock(PETSC_COMM_SELF, 4, nodes, blocks.data(), PETSC_COPY_VALUES, from.out()),
+        "ISCreateBlock");
     petsc::check(VecCreateSeq(PETSC_COMM_SELF, 4 * nodes, piece_.out()), "VecCreateSeq");
     petsc::check(VecScatterCreate(rhs_, from, piece_, nullptr, gather_.out()), "VecScatterCreate");
     insertion_.emplace(matrix_, numbering_);
@@ -80,8 +81,10 @@ class OseenSystem {
 
   // v's values at every node of the piece.
   void gather(Vec v, FlowField& field) {
-    petsc::check(VecScatterBegin(gather_, v, piece_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
-    petsc::check(VecScatterEnd(gather_, v, piece_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+    petsc::check(VecScatterBegin(gather_, v, piece_, INSERT_VALUES, SCATTER_FORWARD),
+                 "VecScatterBegin");
+    petsc::check(VecScatterEnd(gather_, v, piece_, INSERT_VALUES, SCATTER_FORWARD),
+                 "VecScatterEnd");
     const PetscScalar* x = nullptr;
     petsc::check(VecGetArrayRead(piece_, &x), "VecGetArrayRead");
     for (std::size_t k = 0; k < field.pressure.size(); ++k) {
@@ -117,12 +120,13 @@ class OseenSystem {
     PetscInt local = 0, global = 0;
     petsc::check(MatGetLocalSize(matrix_, &local, nullptr), "MatGetLocalSize");
     petsc::check(MatGetSize(matrix_, &global, nullptr), "MatGetSize");
-    petsc::check(MatCreateShell(PetscObjectComm(reinterpret_cast<PetscObject>(matrix_.get())), local,
-                         local, global, global, this, newton_operator_.out()),
-          "MatCreateShell");
-    petsc::check(MatShellSetOperation(newton_operator_, MATOP_MULT,
-                               reinterpret_cast<void (*)(void)>(&OseenSystem::newton_product)),
-          "MatShellSetOperation");
+    petsc::check(MatCreateShell(PetscObjectComm(reinterpret_cast<PetscObject>(matrix_.get())),
+                                local, local, global, global, this, newton_operator_.out()),
+                 "MatCreateShell");
+    petsc::check(
+        MatShellSetOperation(newton_operator_, MATOP_MULT,
+                             reinterpret_cast<void (*)(void)>(&OseenSystem::newton_product)),
+        "MatShellSetOperation");
     petsc::check(VecDuplicate(piece_, operand_.out()), "VecDuplicate");
     petsc::check(VecDuplicate(piece_, product_.out()), "VecDuplicate");
   }
@@ -282,11 +286,12 @@ class OseenSystem {
                     D(4 * i + c, 4 * j + d);
           }
       }
-      petsc::check(MatSetValuesBlocked(matrix_, m, ids.data(), m, ids.data(), block.data(), ADD_VALUES),
-            "MatSetValuesBlocked");
+      petsc::check(
+          MatSetValuesBlocked(matrix_, m, ids.data(), m, ids.data(), block.data(), ADD_VALUES),
+          "MatSetValuesBlocked");
       if (linearization != Linearization::picard)
         petsc::check(VecSetValuesBlocked(residual_, m, ids.data(), r.data(), ADD_VALUES),
-              "VecSetValuesBlocked");
+                     "VecSetValuesBlocked");
     };
     for_each_boundary_face(mesh_, [&](std::span<const NodeId> v, int patch) {
       if (patch == backflow_patch_) face(v);
@@ -324,10 +329,10 @@ class OseenSystem {
       oseen_element<E>(X, a, &grad, nu, force, sys, p, linearization);
       insertion_->add(std::span<const NodeId>(cell.data(), N), sys.K.data());
       petsc::check(VecSetValuesBlocked(rhs_, N, blocks.data(), sys.F.data(), ADD_VALUES),
-            "VecSetValuesBlocked");
+                   "VecSetValuesBlocked");
       if (linearization != Linearization::picard)
         petsc::check(VecSetValuesBlocked(residual_, N, blocks.data(), sys.R.data(), ADD_VALUES),
-              "VecSetValuesBlocked");
+                     "VecSetValuesBlocked");
     }
   }
 

@@ -1,8 +1,6 @@
 // The command line against bad input: each case must print one line `naris: error: ...` that
 // names the problem, exit non-zero, and leave no output file behind.
 #include <gtest/gtest.h>
-
-#include <nlohmann/json.hpp>
 #include <sys/wait.h>
 
 #include <cmath>
@@ -10,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <regex>
 #include <sstream>
@@ -703,7 +702,7 @@ TEST_F(Cli, SolveOnTwoRanksMatchesOneRank) {
     EXPECT_NEAR(summary(two, key), summary(one, key), 2e-6 * std::abs(summary(one, key))) << key;
   // The fields each rank solved on its piece, gathered into one file.
   const naris::airflow::SolutionState a = naris::airflow::read_solution_h5(one / "solution.h5"),
-                                 b = naris::airflow::read_solution_h5(two / "solution.h5");
+                                      b = naris::airflow::read_solution_h5(two / "solution.h5");
   ASSERT_EQ(a.field.pressure.size(), b.field.pressure.size());
   double speed = 0.0, du = 0.0;
   for (std::size_t k = 0; k < a.field.velocity.size(); ++k) {
@@ -741,7 +740,8 @@ TEST_F(Cli, SolveBadInput) {
             0);
   expect_clean_failure(naris("solve " + cut.string() + " --re 0" + o), "must be positive");
   expect_clean_failure(naris("solve " + cut.string() + " --re -5" + o), "must be positive");
-  expect_clean_failure(naris("solve " + cut.string() + " --re nan" + o), "--re: 'nan' is not a number");
+  expect_clean_failure(naris("solve " + cut.string() + " --re nan" + o),
+                       "--re: 'nan' is not a number");
   expect_clean_failure(naris("solve " + cut.string() + " --inlet-expression \"1-(r\"" + o),
                        "inlet expression '1-(r'");
   expect_clean_failure(naris("solve " + cut.string() + " --inlet-expression \"r-1\"" + o),

@@ -49,11 +49,11 @@ void expect_one_table(const char* stage) {
   const auto options = stage_options(*cmd);
   EXPECT_EQ(options.size(), s.table.entries().size()) << stage;
   for (const CLI::Option* o : options) {
-    const auto found =
-        std::find_if(s.table.entries().begin(), s.table.entries().end(),
-                     [&](const Settings::Entry& e) { return o->check_name(Settings::option_name(e)); });
-    EXPECT_NE(found, s.table.entries().end()) << stage << ": option " << o->get_name()
-                                              << " is no case-file key";
+    const auto found = std::find_if(
+        s.table.entries().begin(), s.table.entries().end(),
+        [&](const Settings::Entry& e) { return o->check_name(Settings::option_name(e)); });
+    EXPECT_NE(found, s.table.entries().end())
+        << stage << ": option " << o->get_name() << " is no case-file key";
   }
 }
 
@@ -150,8 +150,8 @@ TEST(StageSettings, UnknownKeysAndListsWhereOneValueIsExpectedAreErrors) {
   MeshSettings s;
   EXPECT_THROW(s.table.read(YAML::Load("{improv: false}"), "mesh"), Error);
   EXPECT_THROW(s.table.read(YAML::Load("{min_edge: [0.1, 0.2]}"), "mesh"), Error);
-  EXPECT_NO_THROW(s.table.read(YAML::Load("{patch: [\"a:sphere=0,0,0,1\", \"b:sphere=1,1,1,1\"]}"),
-                               "mesh"));
+  EXPECT_NO_THROW(
+      s.table.read(YAML::Load("{patch: [\"a:sphere=0,0,0,1\", \"b:sphere=1,1,1,1\"]}"), "mesh"));
   EXPECT_EQ(s.job.regions.size(), 2u);
   EXPECT_TRUE(s.table.given("patch"));
   EXPECT_FALSE(s.table.given("inlet"));

@@ -24,10 +24,10 @@
 #include "core/log.h"
 #include "mesh/io/mesh_h5.h"
 #include "mesh/io/write_vtk.h"
-#include "tests/bench/mortar.h"
 #include "mesh/mve/mve.h"
 #include "mesh/quality/check.h"
 #include "mesh/quality/quality.h"
+#include "tests/bench/mortar.h"
 
 namespace {
 

@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "core/log.h"
+#include "solver/nonlinear/navier_stokes_solver.h"
+#include "solver/parallel/petsc.h"
 #include "tests/solver/manufactured.h"
 #include "tests/solver/meshes.h"
-#include "solver/parallel/petsc.h"
-#include "solver/nonlinear/navier_stokes_solver.h"
 
 using namespace naris;
 
@@ -48,9 +48,9 @@ int main(int argc, char** argv) {
         Stopwatch clock;
         const ns::FlowField f = nonlinear::solve_navier_stokes(
             mesh,
-            ns::FlowProblem{1.0 / nu, force,
-                            testing::exact_on_boundary(mesh, testing::beltrami,
-                                                       testing::beltrami_pressure)},
+            ns::FlowProblem{
+                1.0 / nu, force,
+                testing::exact_on_boundary(mesh, testing::beltrami, testing::beltrami_pressure)},
             options, &report);
         const double seconds = clock.seconds();
         const auto e = testing::l2_errors(mesh, f, testing::beltrami, testing::beltrami_pressure);

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <random>
 
-#include "tests/mesh/field_helpers.h"
 #include "mesh/quality/check.h"
 #include "mesh/quality/improve.h"
 #include "mesh/quality/quality.h"
+#include "tests/mesh/field_helpers.h"
 
 namespace naris {
 namespace {

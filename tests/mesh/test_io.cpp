@@ -17,10 +17,10 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "tests/mesh/field_helpers.h"
 #include "mesh/io/mesh_h5.h"
 #include "mesh/io/write_gmsh.h"
 #include "mesh/io/write_vtk.h"
+#include "tests/mesh/field_helpers.h"
 
 namespace naris {
 namespace {

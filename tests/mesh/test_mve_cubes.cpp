@@ -6,9 +6,9 @@
 #include <random>
 #include <set>
 
-#include "tests/mesh/field_helpers.h"
 #include "mesh/mve/case_table.h"
 #include "mesh/quality/check.h"
+#include "tests/mesh/field_helpers.h"
 
 namespace naris {
 namespace {

@@ -6,8 +6,8 @@
 #include <random>
 
 #include "core/error.h"
-#include "tests/mesh/field_helpers.h"
 #include "mesh/quality/check.h"
+#include "tests/mesh/field_helpers.h"
 
 namespace naris {
 namespace {

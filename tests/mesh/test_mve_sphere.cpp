@@ -5,8 +5,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "tests/mesh/field_helpers.h"
 #include "mesh/quality/check.h"
+#include "tests/mesh/field_helpers.h"
 
 namespace naris {
 namespace {

@@ -6,9 +6,9 @@
 #include <numbers>
 
 #include "core/error.h"
-#include "tests/mesh/field_helpers.h"
 #include "mesh/patches/patches.h"
 #include "mesh/quality/check.h"
+#include "tests/mesh/field_helpers.h"
 
 namespace naris {
 namespace {

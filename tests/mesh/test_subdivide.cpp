@@ -5,10 +5,10 @@
 
 #include <random>
 
-#include "tests/mesh/field_helpers.h"
 #include "mesh/patches/patches.h"
 #include "mesh/quality/check.h"
 #include "mesh/refine/subdivide.h"
+#include "tests/mesh/field_helpers.h"
 
 namespace naris {
 namespace {

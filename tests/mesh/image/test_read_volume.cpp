@@ -13,8 +13,8 @@
 #include <fstream>
 
 #include "core/error.h"
-#include "tests/mesh/image/dicom_writer.h"
 #include "mesh/image/read_volume.h"
+#include "tests/mesh/image/dicom_writer.h"
 
 namespace naris {
 namespace {

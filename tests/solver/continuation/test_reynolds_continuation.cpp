@@ -22,7 +22,9 @@ using nonlinear::NonlinearReport;
 using ns::FlowField;
 
 // A one-node "flow" whose velocity is its Reynolds number: a branch u(Re) = Re.
-FlowField at(double re) { return FlowField{{Eigen::Vector3d(re, 0.0, 0.0)}, {re}}; }
+FlowField at(double re) {
+  return FlowField{{Eigen::Vector3d(re, 0.0, 0.0)}, {re}};
+}
 
 struct Try {
   double reynolds;
@@ -279,8 +281,9 @@ TEST(Arclength, SecantIsAUnitVectorInTheConstraintsMetric) {
   };
   const double length = aim_along_secant(c, at(100.0), 100.0, at(110.0), 110.0, inner);
   EXPECT_NEAR(length, std::sqrt(100.0 + 100.0 / (110.0 * 110.0)), 1e-12);
-  EXPECT_NEAR(inner(c.tangent, c.tangent) + c.tangent_reynolds * c.tangent_reynolds / (110.0 * 110.0),
-              1.0, 1e-12);
+  EXPECT_NEAR(
+      inner(c.tangent, c.tangent) + c.tangent_reynolds * c.tangent_reynolds / (110.0 * 110.0), 1.0,
+      1e-12);
   c.origin = at(110.0);
   c.origin_reynolds = 110.0;
   c.step = length;

@@ -11,17 +11,17 @@
 #include <numbers>
 #include <random>
 
+#include "solver/continuation/arclength.h"
 #include "solver/fem/quadrature.h"
 #include "solver/fem/reference_element.h"
+#include "solver/nonlinear/bordered_step.h"
+#include "solver/nonlinear/forcing_term.h"
+#include "solver/nonlinear/navier_stokes_solver.h"
+#include "solver/nonlinear/preconditioner_reuse.h"
+#include "solver/ns/oseen_element.h"
+#include "solver/parallel/petsc.h"
 #include "tests/solver/manufactured.h"
 #include "tests/solver/meshes.h"
-#include "solver/nonlinear/forcing_term.h"
-#include "solver/continuation/arclength.h"
-#include "solver/nonlinear/bordered_step.h"
-#include "solver/nonlinear/navier_stokes_solver.h"
-#include "solver/ns/oseen_element.h"
-#include "solver/nonlinear/preconditioner_reuse.h"
-#include "solver/parallel/petsc.h"
 #include "tests/solver/residual_history.h"
 
 namespace naris::ns {
@@ -84,8 +84,8 @@ TEST(NavierStokes, CouettePatchTestIsExactOnEveryCellType) {
       NonlinearOptions options;
       options.options_prefix = "patch_";
       NonlinearReport report;
-      const FlowField f =
-          solve_navier_stokes(mesh, ns::FlowProblem{1.0 / nu, {}, exact_on_boundary(mesh, u, p)}, options, &report);
+      const FlowField f = solve_navier_stokes(
+          mesh, ns::FlowProblem{1.0 / nu, {}, exact_on_boundary(mesh, u, p)}, options, &report);
       double eu = 0, ep = 0;
       for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
         eu = std::max(eu, (f.velocity[n] - u(mesh.nodes[n])).norm());
@@ -115,7 +115,9 @@ Rates ethier_steinman(const std::string& kind, const std::vector<int>& sizes, do
     options.tolerance = 1e-9;
     NonlinearReport report;
     const FlowField f = solve_navier_stokes(
-        mesh, ns::FlowProblem{1.0 / nu, force, exact_on_boundary(mesh, beltrami, beltrami_pressure)}, options, &report);
+        mesh,
+        ns::FlowProblem{1.0 / nu, force, exact_on_boundary(mesh, beltrami, beltrami_pressure)},
+        options, &report);
     EXPECT_TRUE(report.converged) << kind << " n " << n;
     const Errors e = l2_errors(mesh, f, beltrami, beltrami_pressure);
     r.h.push_back(2.0 / n);
@@ -214,7 +216,8 @@ TEST(NavierStokes, NewtonConvergesQuadraticallyWithTheWholeDerivative) {
   o.linear_tolerance = o.loosest_linear_tolerance = 1e-12;
   o.max_iterations = 30;
   NonlinearReport report;
-  solve_navier_stokes(problem.mesh, ns::FlowProblem{1.0 / problem.nu, problem.force, problem.bc}, o, &report);
+  solve_navier_stokes(problem.mesh, ns::FlowProblem{1.0 / problem.nu, problem.force, problem.bc}, o,
+                      &report);
   const auto& h = report.residuals;
   for (std::size_t k = 0; k < h.size(); ++k) std::printf("[ info ] residual %zu: %.3e\n", k, h[k]);
   EXPECT_TRUE(testing::ends_quadratically(h));
@@ -238,7 +241,8 @@ TEST(NavierStokes, AssemblyIsAnEventOfPetscsProfile) {
   o.tolerance = 1e-10;
   o.max_iterations = 30;
   NonlinearReport report;
-  solve_navier_stokes(problem.mesh, ns::FlowProblem{1.0 / problem.nu, problem.force, problem.bc}, o, &report);
+  solve_navier_stokes(problem.mesh, ns::FlowProblem{1.0 / problem.nu, problem.force, problem.bc}, o,
+                      &report);
   ASSERT_TRUE(report.converged);
   // One assembly per nonlinear step and the Stokes start; the residual that ends the
   // iteration is an assembly too. Newton follows the Picard steps with the whole derivative.
@@ -258,7 +262,8 @@ TEST(NavierStokes, ArclengthStepFindsTheSolutionAtTheReItReports) {
   o.tolerance = 1e-11;
   o.linear_tolerance = o.loosest_linear_tolerance = 1e-10;
   const FlowField u80 = solve_navier_stokes(mesh, whole, ns::FlowProblem{80, force, bc}, o);
-  const FlowField u90 = solve_navier_stokes(mesh, whole, ns::FlowProblem{90, force, bc}, o, nullptr, &u80);
+  const FlowField u90 =
+      solve_navier_stokes(mesh, whole, ns::FlowProblem{90, force, bc}, o, nullptr, &u80);
   for (const bool forwards : {true, false}) {
     const FlowField& from = forwards ? u80 : u90;
     const FlowField& to = forwards ? u90 : u80;
@@ -266,16 +271,17 @@ TEST(NavierStokes, ArclengthStepFindsTheSolutionAtTheReItReports) {
     ArclengthConstraint c;
     c.origin = to;
     c.origin_reynolds = re_to;
-    c.step = aim_along_secant(c, from, re_from, to, re_to, [&](const FlowField& a, const FlowField& b) {
-      return velocity_inner_product(a, b, whole, PETSC_COMM_WORLD);
-    });
+    c.step =
+        aim_along_secant(c, from, re_from, to, re_to, [&](const FlowField& a, const FlowField& b) {
+          return velocity_inner_product(a, b, whole, PETSC_COMM_WORLD);
+        });
     const FlowField guess = arclength_predictor(c);
     // The predictor's Re, 3 too far: the corrector has to bring Re back to the hyperplane.
     const double re_guess = re_to + c.step * c.tangent_reynolds;
     const double re_start = re_guess + (forwards ? 3.0 : -3.0);
     NonlinearReport report;
-    const FlowField found =
-        solve_navier_stokes(mesh, whole, ns::FlowProblem{re_start, force, bc}, o, &report, &guess, &c);
+    const FlowField found = solve_navier_stokes(mesh, whole, ns::FlowProblem{re_start, force, bc},
+                                                o, &report, &guess, &c);
     ASSERT_TRUE(report.converged) << (forwards ? "forwards" : "backwards");
     std::printf(
         "[ info ] arclength %s: predicted Re %.4f, started at %.4f, found Re %.4f in %d Newton "
@@ -294,8 +300,8 @@ TEST(NavierStokes, ArclengthStepFindsTheSolutionAtTheReItReports) {
                               c.step;
     EXPECT_LT(std::abs(constraint), 1e-6 * c.step);
     // … and the solution at that Re.
-    const FlowField direct =
-        solve_navier_stokes(mesh, whole, ns::FlowProblem{report.reynolds, force, bc}, o, nullptr, &to);
+    const FlowField direct = solve_navier_stokes(
+        mesh, whole, ns::FlowProblem{report.reynolds, force, bc}, o, nullptr, &to);
     double du = 0.0, scale = 0.0;
     for (std::size_t k = 0; k < mesh.nodes.size(); ++k) {
       du = std::max(du, (found.velocity[k] - direct.velocity[k]).norm());
@@ -306,10 +312,10 @@ TEST(NavierStokes, ArclengthStepFindsTheSolutionAtTheReItReports) {
     // in the constraint's metric, pointing on along the step.
     ASSERT_EQ(report.tangent.velocity.size(), mesh.nodes.size());
     const double re = report.reynolds;
-    const FlowField above = solve_navier_stokes(mesh, whole, ns::FlowProblem{re + 0.5, force, bc}, o,
-                                                nullptr, &direct),
-                    below = solve_navier_stokes(mesh, whole, ns::FlowProblem{re - 0.5, force, bc}, o,
-                                                nullptr, &direct);
+    const FlowField above = solve_navier_stokes(mesh, whole, ns::FlowProblem{re + 0.5, force, bc},
+                                                o, nullptr, &direct),
+                    below = solve_navier_stokes(mesh, whole, ns::FlowProblem{re - 0.5, force, bc},
+                                                o, nullptr, &direct);
     FlowField slope = above;  // du/dRe
     for (std::size_t k = 0; k < slope.pressure.size(); ++k) slope.velocity[k] -= below.velocity[k];
     const auto metric = [&](const FlowField& a, double a_re, const FlowField& b, double b_re) {
@@ -337,7 +343,8 @@ TEST(NavierStokes, StalledIterationGivesUpEarly) {
   crawl.max_iterations = 60;
   crawl.stall_steps = 4;
   NonlinearReport report;
-  solve_navier_stokes(problem.mesh, ns::FlowProblem{1.0 / problem.nu, problem.force, problem.bc}, crawl, &report);
+  solve_navier_stokes(problem.mesh, ns::FlowProblem{1.0 / problem.nu, problem.force, problem.bc},
+                      crawl, &report);
   EXPECT_FALSE(report.converged);
   ASSERT_GE(report.residuals.size(), 5u);
   EXPECT_LE(report.iterations, 8);
@@ -355,10 +362,12 @@ TEST(NavierStokes, KeptPreconditionerReachesTheSameSolution) {
   for (NonlinearOptions* o : {&fresh, &kept}) o->tolerance = 1e-10;
   fresh.reuse_preconditioner = false;
   NonlinearReport fresh_report, kept_report;
-  const FlowField a = solve_navier_stokes(problem.mesh, ns::FlowProblem{1.0 / problem.nu, problem.force, problem.bc},
-                                          fresh, &fresh_report);
-  const FlowField b =
-      solve_navier_stokes(problem.mesh, ns::FlowProblem{1.0 / problem.nu, problem.force, problem.bc}, kept, &kept_report);
+  const FlowField a = solve_navier_stokes(
+      problem.mesh, ns::FlowProblem{1.0 / problem.nu, problem.force, problem.bc}, fresh,
+      &fresh_report);
+  const FlowField b = solve_navier_stokes(
+      problem.mesh, ns::FlowProblem{1.0 / problem.nu, problem.force, problem.bc}, kept,
+      &kept_report);
   ASSERT_TRUE(fresh_report.converged);
   ASSERT_TRUE(kept_report.converged);
   EXPECT_EQ(fresh_report.preconditioner_builds, fresh_report.iterations + 1);

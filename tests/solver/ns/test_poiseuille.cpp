@@ -13,12 +13,12 @@
 #include <string>
 
 #include "core/error.h"
-#include "tests/solver/meshes.h"
+#include "solver/nonlinear/navier_stokes_solver.h"
 #include "solver/ns/boundary_conditions.h"
 #include "solver/ns/inlet_expression.h"
-#include "solver/nonlinear/navier_stokes_solver.h"
 #include "solver/ns/patch_integrals.h"
 #include "solver/ns/wall_stress.h"
+#include "tests/solver/meshes.h"
 
 namespace naris::ns {
 namespace {

@@ -9,13 +9,13 @@
 #include <cstdio>
 #include <memory>
 
-#include "tests/solver/manufactured.h"
-#include "tests/solver/meshes.h"
 #include "solver/nonlinear/navier_stokes_solver.h"
 #include "solver/ns/node_graph.h"
 #include "solver/parallel/block_assembly.h"
 #include "solver/parallel/partition.h"
 #include "solver/parallel/petsc.h"
+#include "tests/solver/manufactured.h"
+#include "tests/solver/meshes.h"
 #include "tests/solver/residual_history.h"
 
 namespace naris::ns {

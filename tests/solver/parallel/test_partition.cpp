@@ -6,10 +6,10 @@
 #include <map>
 #include <set>
 
-#include "tests/solver/meshes.h"
 #include "solver/nonlinear/navier_stokes_solver.h"
 #include "solver/ns/distributed_field.h"
 #include "solver/parallel/partition.h"
+#include "tests/solver/meshes.h"
 
 namespace naris::parallel {
 namespace {
