@@ -17,6 +17,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/units.h"
 #include "mesh/image/image_jobs.h"
 #include "mesh/image/phantom.h"
 #include "mesh/image/read_volume.h"
@@ -117,133 +118,152 @@ struct RunOptions {
   bool force = false;
 };
 
-void run_case(const RunOptions& o) {
-  if (!fs::is_regular_file(o.case_file))
+// What a case file asks for: its stages in order, each with its files and settings.
+struct CasePlan {
+  std::string name;
+  fs::path out;
+  std::vector<Stage> stages;
+  std::optional<int> phantom_subject;  // the phantom knows its exact airway
+  fs::path airway;                     // the segmentation, when the case segments
+};
+
+YAML::Node load_case(const fs::path& case_file) {
+  if (!fs::is_regular_file(case_file))
     fail("{}: no such case file (give a case.yaml, e.g. cases/phantom/case.yaml)",
-         o.case_file.string());
+         case_file.string());
   YAML::Node root;
   try {
-    root = YAML::LoadFile(o.case_file.string());
+    root = YAML::LoadFile(case_file.string());
   } catch (const YAML::Exception& e) {
-    fail("{}: not valid YAML: {}", o.case_file.string(), e.what());
+    fail("{}: not valid YAML: {}", case_file.string(), e.what());
   }
-  if (!root.IsMap()) fail("{}: a case file is a map of stages", o.case_file.string());
-  const std::string where = o.case_file.filename().string();
-  const fs::path base = fs::absolute(o.case_file).parent_path();
-  auto resolve = [&](const fs::path& p) { return p.is_absolute() ? p : base / p; };
+  if (!root.IsMap()) fail("{}: a case file is a map of stages", case_file.string());
+  return root;
+}
 
+// phantom → ct.nrrd (+ exact.nrrd)
+void plan_phantom(Section& section, const YAML::Node& node, const fs::path& ct, CasePlan& plan) {
+  auto job = std::make_shared<PhantomJob>();
+  bool exact_mask = true;
+  section.get("subject", job->subject);
+  section.get("pixel", job->sampling.pixel);
+  section.get("slice", job->sampling.slice);
+  section.get("noise", job->sampling.noise);
+  section.get("exact_mask", exact_mask);
+  section.finish();
+  job->output = ct;
+  if (exact_mask) job->exact_mask = plan.out / "exact.nrrd";
+  plan.phantom_subject = job->subject;
+  plan.stages.push_back({"phantom", {}, {job->output}, dump(node), [job] {
+                           return format_phantom_summary(*job, run_phantom_job(*job));
+                         }});
+  if (exact_mask) plan.stages.back().outputs.push_back(job->exact_mask);
+}
+
+// interpolate → interpolated.nrrd, segment → airway.nrrd (each when the case has it); returns
+// the image the mesher takes.
+fs::path plan_image_stages(const YAML::Node& root, const std::string& where, fs::path image,
+                           CasePlan& plan) {
+  if (present(root["interpolate"])) {
+    InterpolateSettings settings;
+    settings.table.read(root["interpolate"], where + ": interpolate");
+    auto job = std::make_shared<InterpolateJob>(settings.resolve());
+    job->input = image;
+    job->output = image = plan.out / "interpolated.nrrd";
+    plan.stages.push_back(
+        {"interpolate", {job->input}, {job->output}, dump(root["interpolate"]), [job] {
+           return format_interpolate_summary(*job, run_interpolate_job(*job));
+         }});
+  }
+  if (present(root["segment"])) {
+    SegmentSettings settings;
+    settings.table.read(root["segment"], where + ": segment");
+    auto job = std::make_shared<SegmentJob>(settings.resolve());
+    job->input = image;
+    job->output = plan.airway = image = plan.out / "airway.nrrd";
+    plan.stages.push_back({"segment", {job->input}, {job->output}, dump(root["segment"]), [job] {
+                             return format_segment_summary(*job, run_segment_job(*job));
+                           }});
+  }
+  return image;
+}
+
+// mesh → mesh/mesh.h5 and its companions; solve → solution/ (when the case has it).
+void plan_flow_stages(const YAML::Node& root, const std::string& where, const fs::path& base,
+                      const fs::path& image, CasePlan& plan) {
+  const fs::path mesh_file = plan.out / "mesh" / "mesh.h5";
+  MeshSettings mesh;
+  mesh.table.read(root["mesh"], where + ": mesh");
+  auto mesh_job = std::make_shared<MeshJob>(mesh.resolve());
+  mesh_job->input = image;
+  mesh_job->output = mesh_file;
+  plan.stages.push_back(
+      {"mesh", {mesh_job->input}, {mesh_job->output}, dump(root["mesh"]), [job = mesh_job] {
+         MeshJobResult r = run_mesh_job(*job);
+         write_mesh_outputs(*job, r);
+         return format_mesh_summary(*job, r);
+       }});
+  if (!present(root["solve"])) return;
+  SolveSettings solve;
+  solve.table.read(root["solve"], where + ": solve");
+  auto job = std::make_shared<airflow::AirflowJob>(solve.resolve(base));
+  job->mesh = mesh_file;
+  job->output = plan.out / "solution";
+  plan.stages.push_back({"solve",
+                         {job->mesh},
+                         {job->output / "summary.json"},
+                         dump(root["solve"]),
+                         [job, petsc_options = solve.petsc] {
+                           petsc::Session session;
+                           insert_petsc_options(petsc_options);
+                           return airflow::format_airflow_summary(*job,
+                                                                  airflow::run_airflow_job(*job));
+                         }});
+}
+
+// Every setting of every stage read and checked, before anything runs.
+CasePlan plan_case(const fs::path& case_file) {
+  const YAML::Node root = load_case(case_file);
+  const std::string where = case_file.filename().string();
+  const fs::path base = fs::absolute(case_file).parent_path();
+  auto resolve = [&](const fs::path& p) { return p.is_absolute() ? p : base / p; };
+  CasePlan plan;
   Section top(root, where);
-  std::string name = o.case_file.parent_path().filename().string(), output = "results", input;
-  top.get("name", name);
+  std::string output = "results", input;
+  plan.name = case_file.parent_path().filename().string();
+  top.get("name", plan.name);
   top.get("output", output);
   top.get("input", input);
-  Section phantom_s(root["phantom"], where + ": phantom");
+  Section phantom(root["phantom"], where + ": phantom");
   for (const char* key : {"phantom", "interpolate", "segment", "mesh", "solve"}) top.allow(key);
   top.finish();
-  if (phantom_s.present() == !input.empty())
+  if (phantom.present() == !input.empty())
     fail("{}: give either 'input' (a CT volume or DICOM folder) or a 'phantom' section", where);
   if (!present(root["mesh"])) fail("{}: the case has no 'mesh' section", where);
-
-  const fs::path out = resolve(output);
-  const fs::path stamps = out / ".naris-run";
-  std::vector<Stage> stages;
-  fs::path ct = input.empty() ? out / "ct.nrrd" : resolve(input);
+  plan.out = resolve(output);
+  const fs::path ct = input.empty() ? plan.out / "ct.nrrd" : resolve(input);
   if (!input.empty() && !fs::exists(ct)) fail("{}: input {} does not exist", where, ct.string());
+  if (phantom.present()) plan_phantom(phantom, root["phantom"], ct, plan);
+  const fs::path image = plan_image_stages(root, where, ct, plan);
+  plan_flow_stages(root, where, base, image, plan);
+  return plan;
+}
 
-  // phantom → ct.nrrd (+ exact.nrrd)
-  std::optional<int> phantom_subject;
-  fs::path exact;
-  if (phantom_s.present()) {
-    auto job = std::make_shared<PhantomJob>();
-    bool exact_mask = true;
-    phantom_s.get("subject", job->subject);
-    phantom_s.get("pixel", job->sampling.pixel);
-    phantom_s.get("slice", job->sampling.slice);
-    phantom_s.get("noise", job->sampling.noise);
-    phantom_s.get("exact_mask", exact_mask);
-    phantom_s.finish();
-    job->output = ct;
-    if (exact_mask) job->exact_mask = exact = out / "exact.nrrd";
-    phantom_subject = job->subject;
-    stages.push_back({"phantom", {}, {job->output}, dump(root["phantom"]), [job] {
-                        return format_phantom_summary(*job, run_phantom_job(*job));
-                      }});
-    if (exact_mask) stages.back().outputs.push_back(exact);
-  }
-  // interpolate → interpolated.nrrd
-  fs::path image = ct;
-  if (present(root["interpolate"])) {
-    auto settings = std::make_shared<InterpolateSettings>();
-    settings->table.read(root["interpolate"], where + ": interpolate");
-    auto job = std::make_shared<InterpolateJob>(settings->resolve());
-    job->input = image;
-    job->output = image = out / "interpolated.nrrd";
-    stages.push_back({"interpolate", {job->input}, {job->output}, dump(root["interpolate"]), [job] {
-                        return format_interpolate_summary(*job, run_interpolate_job(*job));
-                      }});
-  }
-  // segment → airway.nrrd
-  fs::path airway;
-  if (present(root["segment"])) {
-    auto settings = std::make_shared<SegmentSettings>();
-    settings->table.read(root["segment"], where + ": segment");
-    auto job = std::make_shared<SegmentJob>(settings->resolve());
-    job->input = image;
-    job->output = airway = image = out / "airway.nrrd";
-    stages.push_back({"segment", {job->input}, {job->output}, dump(root["segment"]), [job] {
-                        return format_segment_summary(*job, run_segment_job(*job));
-                      }});
-  }
-  // mesh → mesh/mesh.h5 and its companions
-  const fs::path mesh_file = out / "mesh" / "mesh.h5";
-  {
-    auto settings = std::make_shared<MeshSettings>();
-    settings->table.read(root["mesh"], where + ": mesh");
-    auto job = std::make_shared<MeshJob>(settings->resolve());
-    job->input = image;
-    job->output = mesh_file;
-    stages.push_back({"mesh", {job->input}, {job->output}, dump(root["mesh"]), [job] {
-                        MeshJobResult r = run_mesh_job(*job);
-                        write_mesh_outputs(*job, r);
-                        return format_mesh_summary(*job, r);
-                      }});
-  }
-  // solve → solution/ (the case has a solve: section)
-  if (present(root["solve"])) {
-    auto settings = std::make_shared<SolveSettings>();
-    settings->table.read(root["solve"], where + ": solve");
-    auto job = std::make_shared<airflow::AirflowJob>(settings->resolve(base));
-    job->mesh = mesh_file;
-    job->output = out / "solution";
-    const std::string petsc_options = settings->petsc;
-    stages.push_back({"solve",
-                      {job->mesh},
-                      {job->output / "summary.json"},
-                      dump(root["solve"]),
-                      [job, petsc_options] {
-                        petsc::Session session;
-                        insert_petsc_options(petsc_options);
-                        return airflow::format_airflow_summary(*job,
-                                                               airflow::run_airflow_job(*job));
-                      }});
-  }
-
-  // Every setting is checked: only now does the case touch the disk.
-  ensure_writable_folder(out);
+// Each stage in order, skipped when up to date and nothing before it ran.
+std::vector<StageOutcome> run_stages(const CasePlan& plan, bool force) {
+  const fs::path stamps = plan.out / ".naris-run";
   fs::create_directories(stamps);
-  log_line(fmt::format("naris run: case '{}' ({}), {} stage(s), output {}", name,
-                       o.case_file.string(), stages.size(), out.string()));
-  Stopwatch total;
   std::vector<StageOutcome> outcomes;
   bool upstream_ran = false;
-  for (std::size_t i = 0; i < stages.size(); ++i) {
-    const Stage& s = stages[i];
+  const std::size_t n = plan.stages.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Stage& s = plan.stages[i];
     const fs::path stamp = stamps / (s.name + ".settings");
     StageOutcome outcome{s.name, false, 0.0, s.outputs.front()};
-    if (!o.force && !upstream_ran && up_to_date(s, stamp)) {
-      log_line(fmt::format("[{}/{}] {}: up to date, skipped", i + 1, stages.size(), s.name));
+    if (!force && !upstream_ran && up_to_date(s, stamp)) {
+      log_line(fmt::format("[{}/{}] {}: up to date, skipped", i + 1, n, s.name));
     } else {
-      log_line(fmt::format("[{}/{}] {}", i + 1, stages.size(), s.name));
+      log_line(fmt::format("[{}/{}] {}", i + 1, n, s.name));
       fs::remove(stamp);  // a stage that fails half-way must not look up to date
       Stopwatch clock;
       const std::string summary = s.run();
@@ -254,18 +274,29 @@ void run_case(const RunOptions& o) {
     }
     outcomes.push_back(outcome);
   }
+  return outcomes;
+}
 
-  std::string table = fmt::format("naris run: case '{}' done in {:.1f} s\n", name, total.seconds());
+void run_case(const RunOptions& o) {
+  const CasePlan plan = plan_case(o.case_file);
+  // Every setting is checked: only now does the case touch the disk.
+  ensure_writable_folder(plan.out);
+  log_line(fmt::format("naris run: case '{}' ({}), {} stage(s), output {}", plan.name,
+                       o.case_file.string(), plan.stages.size(), plan.out.string()));
+  Stopwatch total;
+  const std::vector<StageOutcome> outcomes = run_stages(plan, o.force);
+  std::string table =
+      fmt::format("naris run: case '{}' done in {:.1f} s\n", plan.name, total.seconds());
   for (const auto& oc : outcomes)
     table += fmt::format("  {:<12} {:<8} {:>9}  {}\n", oc.name, oc.ran ? "ran" : "skipped",
                          oc.ran ? fmt::format("{:.2f} s", oc.seconds) : "-", oc.output.string());
-  if (phantom_subject && !airway.empty()) {
+  if (plan.phantom_subject && !plan.airway.empty()) {
     // The phantom knows its exact airway: score the segmentation on its own grid.
-    const Volume<std::uint8_t> mask = to_mask(read_volume(airway));
-    const double d = dice(mask, phantom_mask(NasalPhantom(*phantom_subject), mask.frame));
+    const Volume<std::uint8_t> mask = to_mask(read_volume(plan.airway));
+    const double d = dice(mask, phantom_mask(NasalPhantom(*plan.phantom_subject), mask.frame));
     table += fmt::format("  segmentation vs the phantom's exact airway: Dice {:.4f}\n", d);
   }
-  table += fmt::format("  peak memory {:.0f} MB", peak_memory_bytes() / 1048576.0);
+  table += fmt::format("  peak memory {:.0f} MB", megabytes(peak_memory_bytes()));
   log_line(table);
 }
 
@@ -275,8 +306,8 @@ void add_run_command(CLI::App& app) {
   auto [o, cmd] = add_stage<RunOptions>(
       app, "run",
       "Run a case file: phantom or input CT → interpolate → segment → mesh → solve, each stage "
-      "writing "
-      "its file in the case's output folder and skipped when its outputs are newer than its "
+      "writing its file in the case's output folder and skipped when its outputs are newer than "
+      "its "
       "inputs and its settings are unchanged");
   cmd->add_option("case", o->case_file, "case file (YAML), e.g. cases/phantom/case.yaml")
       ->required();

@@ -39,14 +39,14 @@ int parse_setting_int(const std::string& text, const std::string& where) {
   fail("{}: '{}' is not a whole number", where, text);
 }
 
-Settings::Entry& Settings::push(Entry e) {
+Settings& Settings::push(Entry e) {
   for (const Entry& other : entries_)
     if (other.name == e.name) fail("internal: the setting '{}' is defined twice", e.name);
   entries_.push_back(std::move(e));
-  return entries_.back();
+  return *this;
 }
 
-Settings::Entry& Settings::add(std::string name, bool& target, std::string help) {
+Settings& Settings::add(std::string name, bool& target, std::string help) {
   Entry e;
   e.name = std::move(name);
   e.help = std::move(help);
@@ -65,8 +65,7 @@ Settings::Entry& Settings::add(std::string name, bool& target, std::string help)
   return push(std::move(e));
 }
 
-Settings::Entry& Settings::add(std::string name, std::vector<std::string>& target,
-                               std::string help) {
+Settings& Settings::add(std::string name, std::vector<std::string>& target, std::string help) {
   Entry e;
   e.name = std::move(name);
   e.help = std::move(help);

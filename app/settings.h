@@ -27,11 +27,11 @@ class Settings {
 
   // A value read as T (double, int, std::string, or an optional of one: unset by default).
   template <class T>
-  Entry& add(std::string name, T& target, std::string help);
-  Entry& add(std::string name, bool& target, std::string help);
-  Entry& add(std::string name, std::vector<std::string>& target, std::string help);
+  Settings& add(std::string name, T& target, std::string help);
+  Settings& add(std::string name, bool& target, std::string help);
+  Settings& add(std::string name, std::vector<std::string>& target, std::string help);
 
-  // Checks on the last entry added.
+  // Checks on the entry just added: table.add(…).positive().
   Settings& range(double lo, double hi);
   Settings& positive();
   Settings& non_negative();
@@ -47,7 +47,7 @@ class Settings {
   static std::string option_name(const Entry& e);
 
  private:
-  Entry& push(Entry e);
+  Settings& push(Entry e);
   void check_last(std::function<void(double, const std::string&)> check);
 
   std::vector<Entry> entries_;
@@ -64,7 +64,7 @@ double parse_setting_double(const std::string& text, const std::string& where);
 int parse_setting_int(const std::string& text, const std::string& where);
 
 template <class T>
-Settings::Entry& Settings::add(std::string name, T& target, std::string help) {
+Settings& Settings::add(std::string name, T& target, std::string help) {
   Entry e;
   e.name = std::move(name);
   e.help = std::move(help);

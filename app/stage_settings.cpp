@@ -10,23 +10,18 @@ std::filesystem::path resolve_path(const std::filesystem::path& base,
 }
 
 InterpolateSettings::InterpolateSettings() {
-  table.add("method", method, "hsr, linear or shape");
-  table.one_of({"hsr", "linear", "shape"});
-  table.add("axis", job.axis, "slice axis: i, j, k, or auto (the coarsest)");
-  table.one_of({"auto", "i", "j", "k"});
-  table.add("insert", job.insert, "slices to insert between each pair");
-  table.non_negative();
-  table.add("spacing", job.spacing,
-            "target spacing along the axis (mm); default: the finest in-plane spacing");
-  table.positive();
-  table.add("block", job.hsr.block, "HSR control-grid block size (pixels)");
-  table.range(2, 256);
-  table.add("levels", job.hsr.levels, "HSR pyramid levels");
-  table.range(1, 12);
-  table.add("iterations", job.hsr.iterations, "HSR iterations per level");
-  table.range(1, 1000);
-  table.add("threads", job.threads, "threads over slice pairs (0: every core)");
-  table.non_negative();
+  table.add("method", method, "hsr, linear or shape").one_of({"hsr", "linear", "shape"});
+  table.add("axis", job.axis, "slice axis: i, j, k, or auto (the coarsest)")
+      .one_of({"auto", "i", "j", "k"});
+  table.add("insert", job.insert, "slices to insert between each pair").non_negative();
+  table
+      .add("spacing", job.spacing,
+           "target spacing along the axis (mm); default: the finest in-plane spacing")
+      .positive();
+  table.add("block", job.hsr.block, "HSR control-grid block size (pixels)").range(2, 256);
+  table.add("levels", job.hsr.levels, "HSR pyramid levels").range(1, 12);
+  table.add("iterations", job.hsr.iterations, "HSR iterations per level").range(1, 1000);
+  table.add("threads", job.threads, "threads over slice pairs (0: every core)").non_negative();
 }
 
 InterpolateJob InterpolateSettings::resolve() const {
@@ -39,15 +34,14 @@ InterpolateJob InterpolateSettings::resolve() const {
 
 SegmentSettings::SegmentSettings() {
   table.add("threshold", job.threshold, "HU threshold, or 'auto'");
-  table.add("inside", inside, "the airway is 'below' or 'above' the threshold");
-  table.one_of({"below", "above"});
+  table.add("inside", inside, "the airway is 'below' or 'above' the threshold")
+      .one_of({"below", "above"});
   table.add("seed", job.seeds, "seed voxel i,j,k or point x,y,z mm in the airway; repeatable");
   table.add("all_components", all_components, "keep every component (default: the largest)");
   table.add("rotate", job.rotate,
             "rotate the volume first, AXIS:DEGREES about image axis i, j or k (e.g. i:30); "
             "seeds in voxels then refer to the rotated grid, seeds in mm do not change");
-  table.add("decimate", job.decimate, "average N×N blocks of each slice first");
-  table.range(1, 16);
+  table.add("decimate", job.decimate, "average N×N blocks of each slice first").range(1, 16);
 }
 
 SegmentJob SegmentSettings::resolve() const {
@@ -60,8 +54,8 @@ SegmentJob SegmentSettings::resolve() const {
 MeshSettings::MeshSettings() {
   table.add("threshold", job.threshold, "inside is below T (CT air; see inside)");
   table.add("label", job.label, "inside is the voxels equal to L (default for 0/1 labelmaps: 1)");
-  table.add("inside", inside, "with a threshold: inside is 'below' or 'above' T");
-  table.one_of({"below", "above"});
+  table.add("inside", inside, "with a threshold: inside is 'below' or 'above' T")
+      .one_of({"below", "above"});
   table.add("inlet", job.inlet,
             "inlet cut plane: voxel index (e.g. j=19) or physical p=x,y,z;n=nx,ny,nz (mm); the "
             "side towards the object's centre is kept");
@@ -70,13 +64,15 @@ MeshSettings::MeshSettings() {
             "carve a named patch out of the wall: name:box=x0,y0,z0,x1,y1,z1 or "
             "name:sphere=x,y,z,r (mm); repeatable");
   table.add("improve", job.improve, "the quality improvement of section 3.3");
-  table.add("min_edge", job.improve_options.min_edge_fraction,
-            "improvement: collapse edges shorter than this fraction of the voxel size");
-  table.range(0.0, 0.5);
-  table.add("subdivide", job.subdivisions,
-            "refine N times after the improvement, each time every cell into 8 of half its size "
-            "filling the same volume (same wall, inlet and outlet; for mesh-convergence studies)");
-  table.range(0, 3);
+  table
+      .add("min_edge", job.improve_options.min_edge_fraction,
+           "improvement: collapse edges shorter than this fraction of the voxel size")
+      .range(0.0, 0.5);
+  table
+      .add("subdivide", job.subdivisions,
+           "refine N times after the improvement, each time every cell into 8 of half its size "
+           "filling the same volume (same wall, inlet and outlet; for mesh-convergence studies)")
+      .range(0, 3);
   table.add("all_components", all_components,
             "keep every connected component (default: the largest only)");
   table.add("check", job.check, "the conformity/watertightness check");
@@ -94,65 +90,73 @@ MeshJob MeshSettings::resolve() const {
 
 SolveSettings::SolveSettings() {
   nonlinear::NonlinearOptions& n = job.nonlinear;
-  table.add("re", job.reynolds, "target Reynolds number on the inlet's d_in = 4A/P");
-  table.positive();
+  table.add("re", job.reynolds, "target Reynolds number on the inlet's d_in = 4A/P").positive();
   table.add("inlet_speed", job.inlet_speed,
             "mean inlet speed (m/s) instead of re; Re then follows from it");
-  table.add("inlet_profile", inlet_profile, "uniform or developed (laminar, any shape)");
-  table.one_of({"uniform", "developed"});
+  table.add("inlet_profile", inlet_profile, "uniform or developed (laminar, any shape)")
+      .one_of({"uniform", "developed"});
   table.add("inlet_expression", job.inlet_expression,
             "inlet profile as an expression of x, y, z and r (mm; r from the inlet's centroid), "
             "e.g. \"1-(r/1.5)^2\"; scaled to the mean inlet speed");
   table.add("nu", job.viscosity, "kinematic viscosity (m²/s)");
   table.add("rho", job.density, "density (kg/m³)");
   table.add("re_start", job.start_reynolds, "first Reynolds number of the continuation");
-  table.add("max_steps", job.max_steps, "continuation steps at most");
-  table.positive();
-  table.add("max_iterations", n.max_iterations,
-            "nonlinear (Picard or Newton) iterations per continuation step at most (500 with the "
-            "segregated scheme unless given)");
-  table.positive();
-  table.add("scheme", scheme,
-            "coupled (Picard then Newton, GMRES on ILU), segregated (FiDAP's momentum / "
-            "pressure-correction sweeps on algebraic multigrid; Picard only) or segregated-gmres "
-            "(GMRES on the whole system preconditioned by one such sweep)");
-  table.one_of({"coupled", "segregated", "segregated-gmres"});
-  table.add("velocity_relaxation", n.velocity_relaxation,
-            "segregated: momentum under-relaxation α_u");
-  table.range(0.01, 1.0);
-  table.add("pressure_relaxation", n.pressure_relaxation,
-            "segregated: pressure-correction relaxation α_p");
-  table.range(0.01, 1.0);
-  table.add("picard_steps", n.picard_steps, "Picard steps before Newton's method takes over");
-  table.non_negative();
+  table.add("max_steps", job.max_steps, "continuation steps at most").positive();
+  table
+      .add("max_iterations", n.max_iterations,
+           "nonlinear (Picard or Newton) iterations per continuation step at most (500 with the "
+           "segregated scheme unless given)")
+      .positive();
+  table
+      .add("scheme", scheme,
+           "coupled (Picard then Newton, GMRES on ILU), segregated (FiDAP's momentum / "
+           "pressure-correction sweeps on algebraic multigrid; Picard only) or segregated-gmres "
+           "(GMRES on the whole system preconditioned by one such sweep)")
+      .one_of({"coupled", "segregated", "segregated-gmres"});
+  table
+      .add("velocity_relaxation", n.velocity_relaxation,
+           "segregated: momentum under-relaxation α_u")
+      .range(0.01, 1.0);
+  table
+      .add("pressure_relaxation", n.pressure_relaxation,
+           "segregated: pressure-correction relaxation α_p")
+      .range(0.01, 1.0);
+  table.add("picard_steps", n.picard_steps, "Picard steps before Newton's method takes over")
+      .non_negative();
   table.add("newton", n.newton, "Newton's method after the Picard steps (off: Picard only)");
-  table.add("linear_tolerance", n.linear_tolerance,
-            "each linear solve's residual reduction, at the tightest");
-  table.range(1e-14, 0.5);
-  table.add("linear_tolerance_max", n.loosest_linear_tolerance,
-            "the loosest reduction, where the nonlinear residual falls slowly (Eisenstat–Walker; "
-            "equal to linear_tolerance: fixed)");
-  table.range(1e-14, 0.5);
-  table.add("tolerance", n.tolerance, "nonlinear residual relative to the load, per step");
-  table.positive();
-  table.add("step_tolerance", job.step_tolerance,
-            "nonlinear residual of the continuation steps before the target (the target's is "
-            "tolerance)");
-  table.positive();
-  table.add("pseudo_cfl", n.pseudo_cfl,
-            "pseudo-transient continuation: first Courant number, grown as the residual falls "
-            "(0: off)");
-  table.non_negative();
-  table.add("arclength_steps", job.arclength_steps,
-            "where the continuation in Re stalls at a turning point, follow the steady branch by "
-            "pseudo-arclength continuation for at most N points (0: stop there)");
-  table.non_negative();
+  table
+      .add("linear_tolerance", n.linear_tolerance,
+           "each linear solve's residual reduction, at the tightest")
+      .range(1e-14, 0.5);
+  table
+      .add("linear_tolerance_max", n.loosest_linear_tolerance,
+           "the loosest reduction, where the nonlinear residual falls slowly (Eisenstat–Walker; "
+           "equal to linear_tolerance: fixed)")
+      .range(1e-14, 0.5);
+  table.add("tolerance", n.tolerance, "nonlinear residual relative to the load, per step")
+      .positive();
+  table
+      .add("step_tolerance", job.step_tolerance,
+           "nonlinear residual of the continuation steps before the target (the target's is "
+           "tolerance)")
+      .positive();
+  table
+      .add("pseudo_cfl", n.pseudo_cfl,
+           "pseudo-transient continuation: first Courant number, grown as the residual falls "
+           "(0: off)")
+      .non_negative();
+  table
+      .add("arclength_steps", job.arclength_steps,
+           "where the continuation in Re stalls at a turning point, follow the steady branch by "
+           "pseudo-arclength continuation for at most N points (0: stop there)")
+      .non_negative();
   table.add("rebuild_preconditioner", rebuild_preconditioner,
             "set the linear solver's preconditioner up anew for every nonlinear step (by default "
             "it is kept while that saves work)");
-  table.add("relaxation", n.relaxation,
-            "largest step fraction (0, 1]; the step is cut back while the residual grows");
-  table.range(0.01, 1.0);
+  table
+      .add("relaxation", n.relaxation,
+           "largest step fraction (0, 1]; the step is cut back while the residual grows")
+      .range(0.01, 1.0);
   table.add("restart", restart,
             "resume the continuation from a checkpoint (the output folder's checkpoint.h5 is "
             "rewritten after every converged step)");
@@ -161,10 +165,11 @@ SolveSettings::SolveSettings() {
             "(naris mesh --subdivide): its field is prolonged onto this one and may be at the "
             "target Re itself");
   table.add("verbose", verbose, "a line per nonlinear (Picard or Newton) step");
-  table.add("progress", n.progress_seconds,
-            "seconds between progress lines in a long solve: a nonlinear step's line, and within "
-            "a linear solve that runs longer, its residual (0: none)");
-  table.non_negative();
+  table
+      .add("progress", n.progress_seconds,
+           "seconds between progress lines in a long solve: a nonlinear step's line, and within "
+           "a linear solve that runs longer, its residual (0: none)")
+      .non_negative();
   table.add("petsc", petsc,
             "PETSc options for the linear solves (prefix ns_), e.g. \"-ns_ksp_monitor\"");
 }

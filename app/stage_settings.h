@@ -19,44 +19,43 @@ namespace naris::app {
 std::filesystem::path resolve_path(const std::filesystem::path& base,
                                    const std::filesystem::path& p);
 
-struct InterpolateSettings {
-  InterpolateJob job;
-  std::string method = "hsr";
+// A stage's job with the library's defaults and the table bound to its fields (not copyable:
+// the table points into the job).
+template <class Job>
+struct StageSettings {
+  Job job;
   Settings table;
+  StageSettings() = default;
+  StageSettings(const StageSettings&) = delete;
+  StageSettings& operator=(const StageSettings&) = delete;
+};
+
+struct InterpolateSettings : StageSettings<InterpolateJob> {
+  std::string method = "hsr";
   InterpolateSettings();
-  InterpolateSettings(const InterpolateSettings&) = delete;
   InterpolateJob resolve() const;
 };
 
-struct SegmentSettings {
-  SegmentJob job;
+struct SegmentSettings : StageSettings<SegmentJob> {
   std::string inside = "below";
   bool all_components = !job.keep_largest;
-  Settings table;
   SegmentSettings();
-  SegmentSettings(const SegmentSettings&) = delete;
   SegmentJob resolve() const;
 };
 
-struct MeshSettings {
-  MeshJob job;
+struct MeshSettings : StageSettings<MeshJob> {
   std::string inside = "below";
   bool all_components = !job.keep_largest;
-  Settings table;
   MeshSettings();
-  MeshSettings(const MeshSettings&) = delete;
   MeshJob resolve() const;
 };
 
-struct SolveSettings {
-  airflow::AirflowJob job;
+struct SolveSettings : StageSettings<airflow::AirflowJob> {
   std::string inlet_profile = "uniform", scheme = "coupled", petsc;
   std::optional<std::string> restart, restart_mesh;
   bool rebuild_preconditioner = !job.nonlinear.reuse_preconditioner;
   bool verbose = job.nonlinear.log_iterations;
-  Settings table;
   SolveSettings();
-  SolveSettings(const SolveSettings&) = delete;
   airflow::AirflowJob resolve(const std::filesystem::path& base = {}) const;
 };
 

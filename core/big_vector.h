@@ -3,7 +3,8 @@
 // std::vector for trivially relocatable elements, but a large block is an anonymous mapping that
 // grows with mremap: growing a gigabyte array moves page mappings instead of copying the data
 // into freshly faulted pages. Large blocks are also marked for transparent huge pages, which
-// cuts page faults ~500×. Both matter: filling memory is the mesher's main cost.
+// cuts page faults sharply (docs/results/solver-choices.md). Both matter: filling memory is
+// the mesher's main cost.
 #include <sys/mman.h>
 
 #include <algorithm>

@@ -186,8 +186,8 @@ void refine(const Image2D& i1, const Image2D& i2, Grid& g, int iterations) {
     } else {
       // The damping never drops below 0.3 of the largest block: control points whose support
       // barely touches an edge have nearly singular blocks, and without a floor their
-      // preconditioned steps run away (displacements of 100+ pixels on real slices) even with
-      // the one-pixel cap. 0.3 keeps the two-squares registration exact within 50 iterations.
+      // preconditioned steps run away even with the one-pixel cap; 0.3 still lets the
+      // two-squares test register exactly (docs/results/solver-choices.md).
       lambda = std::max(lambda / 10.0, 0.3);
     }
   }

@@ -10,15 +10,8 @@ namespace naris {
 enum class InsideRule { below, above, label };
 
 inline const char* inside_rule_name(InsideRule rule) {
-  switch (rule) {
-    case InsideRule::below:
-      return "below";
-    case InsideRule::above:
-      return "above";
-    case InsideRule::label:
-      return "label";
-  }
-  return "";
+  constexpr const char* names[] = {"below", "above", "label"};
+  return names[static_cast<int>(rule)];
 }
 
 // "below" or "above" (a threshold's side, as the command line and case files give it).

@@ -84,7 +84,7 @@ void run_writer(Writer* writer, const std::filesystem::path& path) {
 
 // The volume mesh is the largest file naris writes, so it is written here directly from the
 // mesh arrays as VTK XML with raw appended data (VTK's own writer copies every array first and
-// is ~40× slower). The tests read it back with VTK's reader.
+// is much slower; docs/results/solver-choices.md). The tests read it back with VTK's reader.
 void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
                const CellFields& cell_fields, const PointFields& point_fields) {
   check_field_sizes(mesh, cell_fields, point_fields);

@@ -175,8 +175,13 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   problem.conditions = ns::local_conditions(m.conditions, part.piece.numbering);
   problem.backflow.patch = m.outlet;
   problem.backflow.beta = 1.0;
-  const SolutionScales scales{r.reynolds,  r.u_in,        r.d_in_mm,
-                              job.density, job.viscosity, m.fingerprint};
+  // What every solution file of the run carries besides its field and Re.
+  SolutionState scales{.target_reynolds = r.reynolds,
+                       .u_in = r.u_in,
+                       .d_in_mm = r.d_in_mm,
+                       .density = job.density,
+                       .viscosity = job.viscosity,
+                       .mesh_fingerprint = m.fingerprint};
   PieceSolves solves(
       part.piece.mesh, part.piece.numbering, std::move(problem), m.inlet, m.outlet, scales,
       {job.output / "checkpoint.h5", job.output / "branch.csv", job.output / "residuals.csv"});

@@ -15,7 +15,7 @@
 namespace naris::airflow {
 
 PieceSolves::PieceSolves(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
-                         ns::FlowProblem problem, int inlet, int outlet, SolutionScales scales,
+                         ns::FlowProblem problem, int inlet, int outlet, SolutionState scales,
                          RunFiles files)
     : piece_(piece),
       numbering_(numbering),
@@ -41,15 +41,9 @@ double PieceSolves::inner_product(const ns::FlowField& a, const ns::FlowField& b
 }
 
 SolutionState PieceSolves::state_at(const ns::FlowField& field, double reynolds) const {
-  SolutionState s;
+  SolutionState s = scales_;
   s.field = ns::gather_field(field, numbering_, PETSC_COMM_WORLD, 0);
   s.reynolds = reynolds;
-  s.target_reynolds = scales_.target_reynolds;
-  s.u_in = scales_.u_in;
-  s.d_in_mm = scales_.d_in_mm;
-  s.density = scales_.density;
-  s.viscosity = scales_.viscosity;
-  s.mesh_fingerprint = scales_.mesh_fingerprint;
   return s;
 }
 

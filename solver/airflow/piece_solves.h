@@ -12,12 +12,6 @@
 
 namespace naris::airflow {
 
-// What every solution file of the run carries besides its field.
-struct SolutionScales {
-  double target_reynolds = 0.0, u_in = 0.0, d_in_mm = 0.0, density = 0.0, viscosity = 0.0;
-  std::uint64_t mesh_fingerprint = 0;
-};
-
 struct RunFiles {
   std::filesystem::path checkpoint, branch, residuals;
 };
@@ -25,9 +19,9 @@ struct RunFiles {
 class PieceSolves final : public continuation::SteadySolves {
  public:
   // `problem` holds the piece's conditions; its Reynolds number is set for each solve.
+  // `scales`: what every solution file of the run carries besides its field and Re.
   PieceSolves(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
-              ns::FlowProblem problem, int inlet, int outlet, SolutionScales scales,
-              RunFiles files);
+              ns::FlowProblem problem, int inlet, int outlet, SolutionState scales, RunFiles files);
 
   ns::FlowField solve(double reynolds, const nonlinear::NonlinearOptions& options,
                       const ns::FlowField* initial,
@@ -54,7 +48,7 @@ class PieceSolves final : public continuation::SteadySolves {
   const parallel::NodeNumbering& numbering_;
   ns::FlowProblem problem_;
   int inlet_, outlet_;
-  SolutionScales scales_;
+  SolutionState scales_;
   RunFiles files_;
   int rank_ = 0;
   std::string branch_rows_;

@@ -12,8 +12,8 @@ namespace naris::nonlinear {
 // Where the outer iteration contracts slowly — pseudo-time steps at a small Courant number,
 // damped Newton steps far from the solution — a linear solve tighter than the residual will
 // fall is wasted; near the solution, where Newton converges fast, η falls with the ratio and
-// the steps stay Newton's. On the neonatal airway it took the solves of the first 15
-// pseudo-time steps at Re 225 from 10–143 GMRES iterations to 2–35.
+// the steps stay Newton's. The solves take far fewer GMRES iterations than with a fixed
+// tolerance (docs/results/solver-choices.md).
 inline double forcing_term(double residual, double previous_residual, double previous_eta,
                            double tightest, double loosest) {
   constexpr double gamma = 0.9, alpha = 2.0;

@@ -6,14 +6,14 @@
 namespace naris::nonlinear {
 
 // Whether the next linear solve may keep the preconditioner built for an earlier one. Building
-// ILU(1) costs as much as 20–40 Krylov iterations (on the phantom at Re 100, 36 % of the run
-// went to the factorizations), and consecutive Picard or Newton matrices differ little near
-// the solution; but a kept factorization costs iterations as the matrix drifts away from it.
-// It is rebuilt for a new kind of linearization, and once the iterations the last solve added
-// over the first one after the build cost more than a build; after a kept solve has run out of
-// its budget, it is no longer kept at all (for the rest of that nonlinear solve). Costs are in
-// any one unit (the solver passes floating-point operations). Solves to different tolerances
-// (forcing_term.h) are compared by their iterations per decade of residual reduction.
+// ILU(1) is a large share of a solve's work (docs/results/solver-choices.md), and consecutive
+// Picard or Newton matrices differ little near the solution; but a kept factorization costs
+// iterations as the matrix drifts away from it. It is rebuilt for a new kind of linearization, and
+// once the iterations the last solve added over the first one after the build cost more than a
+// build; after a kept solve has run out of its budget, it is no longer kept at all (for the rest of
+// that nonlinear solve). Costs are in any one unit (the solver passes floating-point operations).
+// Solves to different tolerances (forcing_term.h) are compared by their iterations per decade of
+// residual reduction.
 enum class LinearProblem { stokes, picard, newton };
 
 class PreconditionerReuse {
@@ -35,13 +35,13 @@ class PreconditionerReuse {
     stale_ = (iterations - fresh_iterations(decades)) * cost_per_iteration_ > setup_cost_;
   }
   // A kept solve ran out of its budget (or failed): the matrices change too fast for keeping
-  // to pay (under pseudo-time on the neonatal airway near Re 470 every other kept solve ran out,
-  // each wasting a whole solve to save a build), so every later solve builds its own.
+  // to pay — each such solve wastes a whole solve to save a build
+  // (docs/results/solver-choices.md) — so every later solve builds its own.
   void abandoned() { enabled_ = false; }
   // Iterations a solve with the kept preconditioner may take before it stops and is redone
   // with a fresh one: the iterations of a fresh solve plus a build's worth, so a kept
-  // factorization that went bad costs at most twice what rebuilding at once would have (on the
-  // neonatal airway a kept ILU once took 276 iterations where a fresh one took 91).
+  // factorization that went bad costs at most twice what rebuilding at once would have
+  // (docs/results/solver-choices.md).
   int iteration_budget(double decades) const {
     const double extra = setup_cost_ / std::max(cost_per_iteration_, 1e-12);
     return static_cast<int>(std::ceil(fresh_iterations(decades)) + std::min(extra, 1e6)) + 1;

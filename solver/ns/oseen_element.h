@@ -59,9 +59,8 @@ enum class Linearization {
 // The metric of the reference cell: identity for the pyramid and the hexahedron (side 2); for
 // the tetrahedron the matrix [2 1 1; 1 2 1; 1 1 2] that makes the metric independent of which
 // vertex is the reference's origin (the unit right tetrahedron seen as an equilateral one, as
-// in PHASTA), times 2 — the factor that balances velocity and pressure accuracy at ν = 1 and
-// ν = 0.01 on the convergence study (bench_ns_convergence; 1 under-stabilizes the pressure at
-// ν = 1, 4 over-diffuses at ν = 0.01).
+// in PHASTA), times 2 — the factor that balances velocity and pressure accuracy on the
+// convergence study (docs/results/solver-choices.md).
 template <class E>
 Eigen::Matrix3d reference_metric() {
   if constexpr (E::type == fem::CellType::tet4) {

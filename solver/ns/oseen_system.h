@@ -50,8 +50,9 @@ class OseenSystem {
       owned_cells(mesh.hexes, owned_hexes_);
     }
     const PetscInt local = numbering.owned;
-    // 4×4 blocks by default (a third less memory and faster ILU); `-ns_mat_type aij` for
-    // preconditioners that split the fields inside a block (fieldsplit).
+    // 4×4 blocks by default (less memory and faster ILU than scalar storage;
+    // docs/results/solver-choices.md); `-ns_mat_type aij` for preconditioners that split the
+    // fields inside a block (fieldsplit).
     matrix_ = block_matrix(mesh, numbering, comm, type, prefix);
     // Dirichlet rows are zeroed every iteration; their pattern must survive for the next one.
     petsc::check(MatSetOption(matrix_, MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE), "MatSetOption");

@@ -11,9 +11,9 @@
 //   (B g)_(i,p) = Σ_K ∫ τ_M ν Σ_c ∂_c N_i Σ_j ∇N_j · g_j,c   (PSPG rows)
 //
 // 15 numbers per edge of the node graph (J has 16), stored in single precision. Newton steps
-// without pseudo-time use it (navier_stokes.cpp): with it Newton converges quadratically, and
-// on the neonatal airway Newton alone from rest reaches Re 50 in 14 steps, where with the
-// term lagged the residual crawls near 1.5e-3 after 16.
+// without pseudo-time use it (navier_stokes_solver.cpp): with it Newton converges
+// quadratically, where with the term lagged the residual crawls
+// (docs/results/solver-choices.md).
 #include <Eigen/Dense>
 #include <cstddef>
 #include <vector>
@@ -60,8 +60,9 @@ class ReconstructionDerivative {
   const HybridMesh& mesh_;
   OwnedCells owned_;
   NodeGraph graph_;  // of every piece node; its edges index the coefficients
-  // The coefficients in single precision, 210 MB less on the neonatal airway (seven digits of
-  // a term of the operator are below any tolerance its linear solves are given).
+  // The coefficients in single precision, half the memory of double (seven digits of a term
+  // of the operator are below any tolerance its linear solves are given;
+  // docs/results/solver-choices.md).
   std::vector<float> recovery_;   // 3 per edge: (1/m_j) ∫ N_j ∂_d N_l
   std::vector<float> supg_;       // 3 per edge
   std::vector<float> pspg_;       // 9 per edge: (c, d) row-major

@@ -56,7 +56,8 @@ SegregatedStep::SegregatedStep(Mat M, const std::string& prefix, double alpha_u,
                         pressure_.out()),
         "ISCreateGeneral");
   // BoomerAMG for momentum; PETSc's smoothed aggregation for the pressure operator, where
-  // BoomerAMG's V-cycle returned NaN on the phantom (C − B D⁻¹ Bᵀ is no M-matrix).
+  // BoomerAMG's V-cycle returns NaN (C − B D⁻¹ Bᵀ is no M-matrix;
+  // docs/results/solver-choices.md).
   setup_solver(momentum_, comm, prefix + "momentum_", v_cycles, true);
   setup_solver(pressure_solver_, comm, prefix + "pressure_", v_cycles, false);
 }

@@ -1,8 +1,8 @@
 #pragma once
 // Element matrices added straight into the value arrays of a 4×4-block PETSc matrix (BAIJ,
 // sequential or MPI) once its nonzero pattern is final. MatSetValuesBlocked searches every
-// block's column in its row and transposes the caller's row-major values block by block: on
-// the neonatal airway that was over a quarter of each assembly. Here each column is found by a
+// block's column in its row and transposes the caller's row-major values block by block, a
+// large share of each assembly (docs/results/solver-choices.md). Here each column is found by a
 // binary search in the row's sorted block columns and each block column of the element matrix
 // (column-major, as the element kernels build it) lands as four contiguous values — PETSc
 // stores a block column-major too. Rows another rank owns still go through

@@ -68,12 +68,20 @@ class FakeSolves final : public SteadySolves {
   void giving_up(const std::vector<ContinuationStep>&) override { gave_up = true; }
 };
 
-ContinuationSettings settings(double pseudo_cfl) {
+ContinuationSettings settings(double pseudo_cfl, double target = 610.0, int max_steps = 40) {
   ContinuationSettings s;
-  s.target = 610.0;
+  s.target = target;
   s.start = 50.0;
+  s.max_steps = max_steps;
   s.nonlinear.pseudo_cfl = pseudo_cfl;
   return s;
+}
+
+// Solves that converge up to Re `limit` only (and at `also`, where given).
+FakeSolves converging_up_to(double limit, double also = -1.0) {
+  FakeSolves solves;
+  solves.converges = [limit, also](double re, bool) { return re <= limit || re == also; };
+  return solves;
 }
 
 class QuietLog : public ::testing::Test {
@@ -103,9 +111,7 @@ TEST_F(ReynoldsContinuationTest, IncrementGrowsByHalfAfterEachEasyStep) {
 TEST_F(ReynoldsContinuationTest, IncrementStaysAfterAStepThatTookAThirdOfItsBudget) {
   FakeSolves solves;
   solves.iterations = 17;  // max_iterations 50: not below 50/3
-  ContinuationSettings s = settings(0.0);
-  s.target = 200.0;
-  ReynoldsContinuation c(s, solves);
+  ReynoldsContinuation c(settings(0.0, 200.0), solves);
   c.run();
   EXPECT_EQ(reynolds_of(solves.tries), (std::vector<double>{50, 100, 150, 200}));
 }
@@ -125,21 +131,14 @@ TEST_F(ReynoldsContinuationTest, StepsBeforeTheTargetStopAtTheStepTolerance) {
     void branch_point(double, const FlowField&, int, double) override {}
     void giving_up(const std::vector<ContinuationStep>&) override {}
   } solves;
-  ContinuationSettings s = settings(0.0);
-  s.target = 100.0;
-  ReynoldsContinuation c(s, solves);
+  ReynoldsContinuation c(settings(0.0, 100.0), solves);
   c.run();
   EXPECT_EQ(solves.tolerance, (std::vector<double>{1e-5, 1e-8}));
 }
 
 TEST_F(ReynoldsContinuationTest, FromRestPseudoTimeFirstThenNewtonThenHalved) {
-  FakeSolves solves;
-  // Nothing converges above Re 100.
-  solves.converges = [](double re, bool) { return re <= 100.0; };
-  ContinuationSettings s = settings(5.0);
-  s.target = 110.0;
-  s.max_steps = 8;
-  ReynoldsContinuation c(s, solves);
+  FakeSolves solves = converging_up_to(100.0);  // nothing converges above Re 100
+  ReynoldsContinuation c(settings(5.0, 110.0, 8), solves);
   EXPECT_THROW(c.run(), Error);
   ASSERT_GE(solves.tries.size(), 5u);
   // Re 50 from rest with pseudo-time; Re 110 (50 + 75, capped) with pseudo-time first, the method
@@ -161,9 +160,7 @@ TEST_F(ReynoldsContinuationTest, TheMethodThatTookTheLastStepGoesFirst) {
   // Pseudo-time fails everywhere but at the first step; Newton converges everywhere.
   int calls = 0;
   solves.converges = [&calls](double, bool pseudo) { return ++calls == 1 || !pseudo; };
-  ContinuationSettings s = settings(5.0);
-  s.target = 300.0;
-  ReynoldsContinuation c(s, solves);
+  ReynoldsContinuation c(settings(5.0, 300.0), solves);
   c.run();
   // 50 (pseudo), 125 (pseudo fails, Newton converges), then Newton first at 237.5 and 300.
   ASSERT_EQ(solves.tries.size(), 5u);
@@ -176,9 +173,7 @@ TEST_F(ReynoldsContinuationTest, TheMethodThatTookTheLastStepGoesFirst) {
 
 TEST_F(ReynoldsContinuationTest, SecantPredictorAfterTwoNewtonSteps) {
   FakeSolves solves;
-  ContinuationSettings s = settings(0.0);
-  s.target = 300.0;
-  ReynoldsContinuation c(s, solves);
+  ReynoldsContinuation c(settings(0.0, 300.0), solves);
   c.run();
   // From rest; from the last field; then from u₁ + (u₁ − u₀)(1/Re − 1/Re₁)/(1/Re₁ − 1/Re₀).
   ASSERT_EQ(solves.tries.size(), 4u);
@@ -190,9 +185,7 @@ TEST_F(ReynoldsContinuationTest, SecantPredictorAfterTwoNewtonSteps) {
 
 TEST_F(ReynoldsContinuationTest, NoSecantAfterAPseudoTimeStep) {
   FakeSolves solves;
-  ContinuationSettings s = settings(5.0);
-  s.target = 300.0;
-  ReynoldsContinuation c(s, solves);
+  ReynoldsContinuation c(settings(5.0, 300.0), solves);
   c.run();
   // Every step converges with pseudo-time: each starts from the last field itself.
   for (std::size_t k = 1; k < solves.tries.size(); ++k)
@@ -200,13 +193,10 @@ TEST_F(ReynoldsContinuationTest, NoSecantAfterAPseudoTimeStep) {
 }
 
 TEST_F(ReynoldsContinuationTest, StallHandsOverToArclengthWhichReachesTheTarget) {
-  FakeSolves solves;
   // Continuation in Re cannot pass Re 300 (a turning point, say); the target itself converges
   // from the chord once the branch has passed it.
-  solves.converges = [](double re, bool) { return re <= 300.0 || re == 610.0; };
-  ContinuationSettings s = settings(0.0);
-  s.max_steps = 100;
-  ReynoldsContinuation c(s, solves);
+  FakeSolves solves = converging_up_to(300.0, 610.0);
+  ReynoldsContinuation c(settings(0.0, 610.0, 100), solves);
   c.run();
   bool arclength = false;
   for (const auto& step : c.steps()) arclength = arclength || step.arclength;
@@ -216,20 +206,19 @@ TEST_F(ReynoldsContinuationTest, StallHandsOverToArclengthWhichReachesTheTarget)
   EXPECT_EQ(solves.tries.back().reynolds, 610.0);
   EXPECT_FALSE(solves.tries.back().arclength);
   EXPECT_DOUBLE_EQ(c.solution().velocity[0][0], 610.0);
-  // The increment fell below 1e-3 of the target before the hand-over: the last Re-step before
-  // the first arclength try is within 0.61 of the last converged Re.
+  // The hand-over came once the increment had been halved below 1e-3 of the target: the last
+  // try in Re failed just past what continuation in Re reaches, within twice that increment.
   std::size_t first = 0;
   while (!solves.tries[first].arclength) ++first;
-  EXPECT_LT(solves.tries[first - 1].reynolds - 300.0, 0.0);
-  EXPECT_GT(solves.tries[first - 1].reynolds, 300.0 - 0.61 * 2);
+  ASSERT_GT(first, 0u);
+  EXPECT_GT(solves.tries[first - 1].reynolds, 300.0);
+  EXPECT_LT(solves.tries[first - 1].reynolds, 300.0 + 2 * 0.61);
   EXPECT_EQ(solves.branch.back(), 610.0);
 }
 
 TEST_F(ReynoldsContinuationTest, StallWithoutArclengthIsAnErrorNamingTheReReached) {
-  FakeSolves solves;
-  solves.converges = [](double re, bool) { return re <= 300.0; };
-  ContinuationSettings s = settings(0.0);
-  s.max_steps = 100;
+  FakeSolves solves = converging_up_to(300.0);
+  ContinuationSettings s = settings(0.0, 610.0, 100);
   s.arclength_steps = 0;
   ReynoldsContinuation c(s, solves);
   try {
@@ -243,8 +232,7 @@ TEST_F(ReynoldsContinuationTest, StallWithoutArclengthIsAnErrorNamingTheReReache
 
 TEST_F(ReynoldsContinuationTest, ResumeTakesThePathTheCheckpointRecorded) {
   FakeSolves solves;
-  ContinuationSettings s = settings(5.0);
-  ReynoldsContinuation c(s, solves);
+  ReynoldsContinuation c(settings(5.0), solves);
   ContinuationState state;
   state.next_step = 100.0;
   state.pseudo_time = false;
