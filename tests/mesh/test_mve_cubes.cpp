@@ -15,8 +15,8 @@ namespace {
 
 using testing::ArrayField;
 
-// Vertex values with the given inside pattern and random magnitudes (which move the isopoints
-// and decide the ambiguous faces).
+// Vertex values with the given inside pattern (one bit per vertex; vertices past the 32nd are
+// outside) and random magnitudes (which move the isopoints and decide the ambiguous faces).
 void fill_pattern(ArrayField& field, unsigned pattern, std::mt19937& rng) {
   std::uniform_real_distribution<float> mag(0.05f, 1.0f);
   const auto& d = field.frame().dims;
@@ -24,7 +24,8 @@ void fill_pattern(ArrayField& field, unsigned pattern, std::mt19937& rng) {
   for (int k = 0; k < d[2]; ++k)
     for (int j = 0; j < d[1]; ++j)
       for (int i = 0; i < d[0]; ++i) {
-        const bool inside = pattern >> bit++ & 1;
+        const bool inside = bit < 32 && (pattern >> bit & 1u);
+        ++bit;
         field.at(i, j, k) = inside ? mag(rng) : -mag(rng);
       }
 }
