@@ -8,6 +8,7 @@
 
 #include "app/commands.h"
 #include "core/atomic_file.h"
+#include "core/csv.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "postproc/figures/line_plot.h"
@@ -53,22 +54,13 @@ OeModel checked(OeModel m, bool stabilize, bool force) {
 
 void write_csv(const fs::path& path, const std::vector<std::string>& names,
                const std::vector<const std::vector<double>*>& columns) {
-  AtomicOutput out(path);
-  {
-    std::FILE* f = std::fopen(out.temp_path().c_str(), "w");
-    if (!f) fail("{}: cannot write", path.string());
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> guard(f, &std::fclose);
-    std::string header;
-    for (const auto& n : names) header += (header.empty() ? "" : ",") + n;
-    std::fprintf(f, "%s\n", header.c_str());
-    for (std::size_t k = 0; k < columns.front()->size(); ++k) {
-      for (std::size_t c = 0; c < columns.size(); ++c)
-        std::fprintf(f, c ? ",%.10g" : "%.10g", (*columns[c])[k]);
-      std::fputc('\n', f);
-    }
-    if (std::fflush(f) != 0) fail("{}: write failed", path.string());
+  CsvTable table(names);
+  for (std::size_t k = 0; k < columns.front()->size(); ++k) {
+    std::vector<std::string> row;
+    for (const auto* c : columns) row.push_back(fmt::format("{:.10g}", (*c)[k]));
+    table.add_row(std::move(row));
   }
-  out.commit();
+  table.write(path);
 }
 
 struct Common {

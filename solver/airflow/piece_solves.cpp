@@ -5,7 +5,6 @@
 
 #include <algorithm>
 
-#include "core/atomic_file.h"
 #include "core/csv.h"
 #include "solver/nonlinear/bordered_step.h"
 #include "solver/nonlinear/navier_stokes_solver.h"
@@ -59,13 +58,10 @@ void PieceSolves::checkpoint(double reynolds, const ns::FlowField& field,
 void PieceSolves::branch_point(double reynolds, const ns::FlowField& f, int newton_steps,
                                double arclength) {
   const double u = scales_.u_in * reynolds / scales_.target_reynolds;  // U_in at that Re, m/s
-  branch_rows_ +=
-      fmt::format("{:.6f},{:.6e},{:.6f},{:.6f},{}\n", reynolds, arclength,
-                  pressure_drop(f) * scales_.density * u * u, max_speed(f) * u, newton_steps);
-  if (!writer()) return;
-  write_text_file(
-      files_.branch,
-      "reynolds,arclength,pressure_drop_pa,max_speed_m_s,newton_steps\n" + branch_rows_);
+  branch_.add_row({fmt::format("{:.6f}", reynolds), fmt::format("{:.6e}", arclength),
+                   fmt::format("{:.6f}", pressure_drop(f) * scales_.density * u * u),
+                   fmt::format("{:.6f}", max_speed(f) * u), std::to_string(newton_steps)});
+  if (writer()) branch_.write(files_.branch);
 }
 
 void PieceSolves::giving_up(const std::vector<continuation::ContinuationStep>& steps) {

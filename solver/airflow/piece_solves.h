@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/csv.h"
 #include "solver/airflow/solution_file.h"
 #include "solver/continuation/reynolds_continuation.h"
 #include "solver/ns/flow_problem.h"
@@ -51,7 +52,7 @@ class PieceSolves final : public continuation::SteadySolves {
   SolutionState scales_;
   RunFiles files_;
   int rank_ = 0;
-  std::string branch_rows_;
+  CsvTable branch_{{"reynolds", "arclength", "pressure_drop_pa", "max_speed_m_s", "newton_steps"}};
 };
 
 // residuals.csv: every nonlinear residual of every step, converged or not.
