@@ -81,16 +81,14 @@ Json quality_json(const QualityReport& q) {
     Json group = Json::object();
     for (std::size_t m = 0; m < kMetrics.size(); ++m) {
       const auto& st = q.summary[g][m];
-      group[metric_name(kMetrics[m])] = {{"count", st.count},
-                                         {"min", significant(st.min)},
-                                         {"p1", significant(st.p1)},
-                                         {"p5", significant(st.p5)},
-                                         {"p50", significant(st.p50)},
-                                         {"p95", significant(st.p95)},
-                                         {"p99", significant(st.p99)},
-                                         {"max", significant(st.max)},
-                                         {"histogram_range", {st.lo, st.hi}},
-                                         {"histogram", st.histogram}};
+      const std::pair<const char*, double> order_statistics[] = {
+          {"min", st.min}, {"p1", st.p1},   {"p5", st.p5},  {"p50", st.p50},
+          {"p95", st.p95}, {"p99", st.p99}, {"max", st.max}};
+      Json stats = {{"count", st.count}};
+      for (const auto& [key, value] : order_statistics) stats[key] = significant(value);
+      stats["histogram_range"] = {st.lo, st.hi};
+      stats["histogram"] = st.histogram;
+      group[metric_name(kMetrics[m])] = std::move(stats);
     }
     out[q.groups[g]] = std::move(group);
   }
