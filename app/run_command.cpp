@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -277,7 +278,20 @@ std::vector<StageOutcome> run_stages(const CasePlan& plan, bool force) {
   return outcomes;
 }
 
+// The ranks of an MPI launch, from the launcher's environment (1 without one).
+int launched_ranks() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
+    if (const char* v = std::getenv(name)) return std::max(1, std::atoi(v));
+  return 1;
+}
+
 void run_case(const RunOptions& o) {
+  // Every rank would write the image stages' files at once.
+  if (const int ranks = launched_ranks(); ranks > 1)
+    fail(
+        "naris run is one process, launched here as {} MPI ranks: run the case without mpirun, "
+        "then naris solve under mpirun on its mesh",
+        ranks);
   const CasePlan plan = plan_case(o.case_file);
   // Every setting is checked: only now does the case touch the disk.
   ensure_writable_folder(plan.out);

@@ -53,10 +53,15 @@ Settings& Settings::add(std::string name, bool& target, std::string help) {
   e.kind = Kind::flag;
   e.default_text = target ? "true" : "false";
   bool* const p = &target;
+  // YAML's spellings of a boolean (YAML 1.1, as yaml-cpp reads them).
   e.set = [p](const std::string& t, const std::string& w) {
-    if (t == "true") {
+    static const std::set<std::string> yes = {"true", "True", "TRUE", "yes", "Yes", "YES",
+                                              "on",   "On",   "ON",   "y",   "Y"};
+    static const std::set<std::string> no = {"false", "False", "FALSE", "no", "No", "NO",
+                                             "off",   "Off",   "OFF",   "n",  "N"};
+    if (yes.count(t)) {
       *p = true;
-    } else if (t == "false") {
+    } else if (no.count(t)) {
       *p = false;
     } else {
       fail("{}: '{}' is neither true nor false", w, t);
@@ -156,11 +161,13 @@ void Settings::add_to(CLI::App* cmd) {
           return true;
         },
         e.help);
-    o->type_size(1)->expected(1);
-    if (e.kind == Kind::list)
-      o->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-    else
-      o->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    o->type_size(1);
+    if (e.kind == Kind::list)  // --seed a b, or --seed a --seed b
+      o->expected(1, CLI::detail::expected_max_vector_size)
+          ->allow_extra_args(true)
+          ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    else  // one value, given once
+      o->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::Throw);
     if (!e.default_text.empty()) o->default_str(e.default_text);
   }
 }
@@ -178,9 +185,9 @@ void Settings::read(const YAML::Node& section, const std::string& where) {
       fail("{}: unknown setting '{}' (known: {})", where, key, fmt::join(known, ", "));
     }
     const std::string at = where + "." + key;
-    given_.insert(key);
     const YAML::Node& v = kv.second;
     if (v.IsNull()) continue;  // as if not given
+    given_.insert(key);
     if (v.IsSequence()) {
       if (found->kind != Kind::list) fail("{}: expected one value, not a list", at);
       for (const auto& item : v) {

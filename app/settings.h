@@ -17,6 +17,11 @@ namespace naris::app {
 
 class Settings {
  public:
+  Settings() = default;
+  // Entries point into the fields they set (and into this table): one table, never a copy.
+  Settings(const Settings&) = delete;
+  Settings& operator=(const Settings&) = delete;
+
   enum class Kind { value, flag, list };
   struct Entry {
     std::string name, help, default_text;

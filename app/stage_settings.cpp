@@ -133,8 +133,10 @@ SolveSettings::SolveSettings() {
            "the loosest reduction, where the nonlinear residual falls slowly (Eisenstat–Walker; "
            "equal to linear_tolerance: fixed)")
       .range(1e-14, 0.5);
-  table.add("tolerance", n.tolerance, "nonlinear residual relative to the load, per step")
-      .positive();
+  table
+      .add("tolerance", n.tolerance,
+           "nonlinear residual relative to the load, per step (0: the absolute tolerance only)")
+      .non_negative();
   table
       .add("step_tolerance", job.step_tolerance,
            "nonlinear residual of the continuation steps before the target (the target's is "

@@ -69,6 +69,7 @@ class NavierStokesSolver {
 
   FlowField solve(NonlinearReport& r) {
     r = {};
+    clock_ = Stopwatch();  // progress lines count from the first step
     for (int it = 0; solves_ <= options_.max_iterations + 1 && it < 4 * options_.max_iterations + 8;
          ++it) {
       const Next next = step(r);

@@ -8,12 +8,14 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <regex>
 #include <sstream>
 #include <vector>
 
+#include "app/stage_settings.h"
 #include "solver/airflow/solution_file.h"
 
 namespace {
@@ -225,6 +227,38 @@ TEST_F(Cli, OutputFolderNotWritable) {
   EXPECT_NE(r.status, 0);
   EXPECT_EQ(r.err.rfind("naris: error: ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find("/proc/naris-test"), std::string::npos) << r.err;
+}
+
+// Each stage that a case file also runs offers on the command line exactly its settings table's
+// entries, with the table's defaults: read from the binary's own --help.
+TEST_F(Cli, EveryStageOptionIsACaseFileKeyWithTheSameDefault) {
+  auto check = [&](const std::string& stage, const naris::app::Settings& table) {
+    const fs::path text = dir_ / (stage + "-help.txt");
+    ASSERT_EQ(std::system(
+                  (std::string(NARIS_BINARY) + " " + stage + " --help > " + text.string()).c_str()),
+              0);
+    std::ifstream in(text);
+    std::map<std::string, std::string> listed;  // option → its shown default
+    const std::regex option(R"(^\s+(?:-\w,)?(--[a-z][a-z0-9-]*)(?: [A-Z]+)?(?:=(\S+))?)");
+    for (std::string line; std::getline(in, line);) {
+      std::smatch m;
+      if (std::regex_search(line, m, option)) listed[m[1]] = m[2];
+    }
+    listed.erase("--help");
+    listed.erase("--output");
+    EXPECT_EQ(listed.size(), table.entries().size()) << stage;
+    for (const auto& e : table.entries()) {
+      const auto it = listed.find(naris::app::Settings::option_name(e));
+      ASSERT_NE(it, listed.end()) << stage << ": the case-file key " << e.name << " is no option";
+      if (e.kind != naris::app::Settings::Kind::flag) {
+        EXPECT_EQ(it->second, e.default_text) << stage << " " << it->first;
+      }
+    }
+  };
+  check("interpolate", naris::app::InterpolateSettings().table);
+  check("segment", naris::app::SegmentSettings().table);
+  check("mesh", naris::app::MeshSettings().table);
+  check("solve", naris::app::SolveSettings().table);
 }
 
 TEST_F(Cli, UnknownOptionIsAnError) {

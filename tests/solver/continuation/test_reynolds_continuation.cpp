@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <functional>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,7 @@ class FakeSolves final : public SteadySolves {
   int iterations = 2;
   std::vector<Try> tries;
   std::vector<double> checkpoints, branch;
+  std::vector<ContinuationState> states;  // what each checkpoint recorded
   bool gave_up = false;
 
   FlowField solve(double re, const NonlinearOptions& o, const FlowField* initial,
@@ -61,8 +63,9 @@ class FakeSolves final : public SteadySolves {
   double inner_product(const FlowField& a, const FlowField& b) override {
     return a.velocity[0].dot(b.velocity[0]);
   }
-  void checkpoint(double re, const FlowField&, const ContinuationState&) override {
+  void checkpoint(double re, const FlowField&, const ContinuationState& state) override {
     checkpoints.push_back(re);
+    states.push_back(state);
   }
   void branch_point(double re, const FlowField&, int, double) override { branch.push_back(re); }
   void giving_up(const std::vector<ContinuationStep>&) override { gave_up = true; }
@@ -216,6 +219,43 @@ TEST_F(ReynoldsContinuationTest, StallHandsOverToArclengthWhichReachesTheTarget)
   EXPECT_EQ(solves.branch.back(), 610.0);
 }
 
+TEST_F(ReynoldsContinuationTest, CheckpointsRecordWhereTheContinuationGoesNext) {
+  FakeSolves newton;
+  ReynoldsContinuation c(settings(0.0, 300.0), newton);
+  c.run();
+  ASSERT_EQ(newton.states.size(), 4u);
+  // After Re 50: the next increment 75, no earlier step; after 125: 112.5, the step at 50.
+  EXPECT_EQ(newton.states[0].next_step, 75.0);
+  EXPECT_EQ(newton.states[0].earlier_reynolds, 0.0);
+  EXPECT_FALSE(newton.states[0].pseudo_time);
+  EXPECT_EQ(newton.states[1].next_step, 112.5);
+  EXPECT_EQ(newton.states[1].earlier_reynolds, 50.0);
+  ASSERT_EQ(newton.states[1].earlier.velocity.size(), 1u);
+  EXPECT_EQ(newton.states[1].earlier.velocity[0][0], 50.0);
+  EXPECT_EQ(newton.states[1].arclength_step, 0.0);
+  // With pseudo-time: marked, and no earlier step for a secant across it.
+  FakeSolves pseudo;
+  ReynoldsContinuation d(settings(5.0, 300.0), pseudo);
+  d.run();
+  for (const auto& s : pseudo.states) {
+    EXPECT_TRUE(s.pseudo_time);
+    EXPECT_EQ(s.earlier_reynolds, 0.0);
+  }
+  // On the branch: the arclength increment and the branch's point before.
+  FakeSolves branch = converging_up_to(300.0, 610.0);
+  ReynoldsContinuation e(settings(0.0, 610.0, 100), branch);
+  e.run();
+  bool on_branch = false;
+  for (const auto& s : branch.states)
+    if (s.arclength_step > 0.0) {
+      on_branch = true;
+      EXPECT_EQ(s.next_step, s.arclength_step);
+      EXPECT_GT(s.earlier_reynolds, 0.0);
+      EXPECT_EQ(s.earlier.velocity[0][0], s.earlier_reynolds);  // the fake's u(Re) = Re
+    }
+  EXPECT_TRUE(on_branch);
+}
+
 TEST_F(ReynoldsContinuationTest, StallWithoutArclengthIsAnErrorNamingTheReReached) {
   FakeSolves solves = converging_up_to(300.0);
   ContinuationSettings s = settings(0.0, 610.0, 100);
@@ -225,7 +265,12 @@ TEST_F(ReynoldsContinuationTest, StallWithoutArclengthIsAnErrorNamingTheReReache
     c.run();
     FAIL() << "a stall must be an error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("stalled at Re 29"), std::string::npos) << e.what();
+    // The last Re reached lies within the final increment (< 1e-3 of the target) below 300.
+    std::smatch m;
+    const std::string what = e.what();
+    ASSERT_TRUE(std::regex_search(what, m, std::regex("stalled at Re ([0-9.]+)"))) << what;
+    EXPECT_GT(std::stod(m[1]), 300.0 - 2 * 0.61) << what;
+    EXPECT_LE(std::stod(m[1]), 300.0) << what;
   }
   EXPECT_TRUE(solves.gave_up);
 }
