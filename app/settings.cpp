@@ -15,9 +15,6 @@ std::string setting_text(double v) {
 std::string setting_text(int v) {
   return fmt::format("{}", v);
 }
-std::string setting_text(const std::string& v) {
-  return v;
-}
 
 double parse_setting_double(const std::string& text, const std::string& where) {
   try {

@@ -62,7 +62,6 @@ class Settings {
 // The text of a value as the table shows it (defaults, help).
 std::string setting_text(double v);
 std::string setting_text(int v);
-std::string setting_text(const std::string& v);
 
 // Parses `text` as T, or fails naming `where`.
 double parse_setting_double(const std::string& text, const std::string& where);

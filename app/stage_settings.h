@@ -19,15 +19,12 @@ namespace naris::app {
 std::filesystem::path resolve_path(const std::filesystem::path& base,
                                    const std::filesystem::path& p);
 
-// A stage's job with the library's defaults and the table bound to its fields (not copyable:
-// the table points into the job).
+// A stage's job with the library's defaults and the table bound to its fields (not copyable,
+// as the table is not: it points into the job).
 template <class Job>
 struct StageSettings {
   Job job;
   Settings table;
-  StageSettings() = default;
-  StageSettings(const StageSettings&) = delete;
-  StageSettings& operator=(const StageSettings&) = delete;
 };
 
 struct InterpolateSettings : StageSettings<InterpolateJob> {

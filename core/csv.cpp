@@ -15,7 +15,6 @@ void CsvTable::add_row(std::vector<std::string> fields) {
   if (fields.size() != columns_)
     fail("internal: a CSV row of {} fields in a table of {} columns", fields.size(), columns_);
   text_ += fmt::format("{}\n", fmt::join(fields, ","));
-  ++rows_;
 }
 
 void CsvTable::write(const std::filesystem::path& path) const {

@@ -11,14 +11,11 @@ class CsvTable {
   explicit CsvTable(std::vector<std::string> columns);
   // One row; as many fields as columns (fields must not hold commas or newlines).
   void add_row(std::vector<std::string> fields);
-  std::size_t rows() const { return rows_; }
-  std::string text() const { return text_; }
   // Throws naris::Error when the write fails (an old file, if any, stays).
   void write(const std::filesystem::path& path) const;
 
  private:
   std::size_t columns_;
-  std::size_t rows_ = 0;
   std::string text_;
 };
 

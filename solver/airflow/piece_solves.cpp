@@ -49,7 +49,9 @@ SolutionState PieceSolves::state_at(const ns::FlowField& field, double reynolds)
 void PieceSolves::checkpoint(double reynolds, const ns::FlowField& field,
                              const continuation::ContinuationState& state) {
   SolutionState s = state_at(field, reynolds);  // collective
-  s.continuation = state;
+  // The scalars; the earlier field gathered from the pieces, not copied.
+  s.continuation = {
+      state.next_step, state.pseudo_time, state.earlier_reynolds, {}, state.arclength_step};
   if (state.earlier_reynolds > 0.0)
     s.continuation.earlier = ns::gather_field(state.earlier, numbering_, PETSC_COMM_WORLD, 0);
   if (writer()) write_solution_h5(s, files_.checkpoint);

@@ -149,7 +149,7 @@ void ReynoldsContinuation::try_step(bool& retry) {
     retry = true;  // the same Re again, with the other method
   } else {
     retry = false;
-    reject(retry);
+    reject();
   }
 }
 
@@ -179,8 +179,7 @@ void ReynoldsContinuation::accept(FlowField field, int iterations, int max_itera
 
 // Both methods failed: half the increment; a stall after Newton steps on one branch hands
 // over to following the branch.
-void ReynoldsContinuation::reject(bool& retry) {
-  retry = false;
+void ReynoldsContinuation::reject() {
   if (reached_ == 0.0) {
     step_ = re_ *= 0.5;  // the very first step: start lower
   } else {

@@ -91,10 +91,11 @@ class ReynoldsContinuation {
                            const ns::FlowField* initial,
                            const nonlinear::ArclengthConstraint* constraint,
                            nonlinear::NonlinearReport* kept = nullptr);
-  // One try at re_; false when the next must be at a lower Re or the other method.
+  // One try at re_; `retry`: it is the second at this Re, with the other method (set for the
+  // next try).
   void try_step(bool& retry);
   void accept(ns::FlowField field, int iterations, int max_iterations, bool pseudo);
-  void reject(bool& retry);
+  void reject();
   void point_below();
   bool follow_branch(double ds);
   void record_branch_point(double re, const ns::FlowField& field, int newton, double along);
