@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   naris::app::add_segment_command(app);
   naris::app::add_mesh_command(app);
   naris::app::add_solve_command(app);
+  naris::app::add_trace_command(app);
   naris::app::add_eog_command(app);
   naris::app::add_run_command(app);
   try {

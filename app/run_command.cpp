@@ -15,6 +15,7 @@
 
 #include "app/commands.h"
 #include "app/stage_settings.h"
+#include "app/trace_figures.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -204,7 +205,10 @@ void plan_flow_stages(const YAML::Node& root, const std::string& where, const fs
          write_mesh_outputs(*job, r);
          return format_mesh_summary(*job, r);
        }});
-  if (!present(root["solve"])) return;
+  if (!present(root["solve"])) {
+    if (present(root["trace"])) fail("{}: the trace stage needs a solve section", where);
+    return;
+  }
   SolveSettings solve;
   solve.table.read(root["solve"], where + ": solve");
   auto job = std::make_shared<airflow::AirflowJob>(solve.resolve(base));
@@ -219,6 +223,24 @@ void plan_flow_stages(const YAML::Node& root, const std::string& where, const fs
                            insert_petsc_options(petsc_options);
                            return airflow::format_airflow_summary(*job,
                                                                   airflow::run_airflow_job(*job));
+                         }});
+  if (!present(root["trace"])) return;
+  auto trace = std::make_shared<TraceSettings>();
+  trace->table.read(root["trace"], where + ": trace");
+  auto trace_job = std::make_shared<particles::TraceJob>(trace->resolve(base));
+  trace_job->solution = job->output / "solution.h5";
+  trace_job->output = plan.out / "trace";
+  std::vector<fs::path> trace_inputs{trace_job->solution};
+  if (!trace_job->points.empty()) trace_inputs.push_back(trace_job->points);
+  if (trace_job->mesh) trace_inputs.push_back(*trace_job->mesh);
+  plan.stages.push_back({"trace",
+                         trace_inputs,
+                         {trace_job->output / "summary.json"},
+                         dump(root["trace"]),
+                         [trace_job, figures = trace->figures] {
+                           const particles::TraceResult r = particles::run_trace_job(*trace_job);
+                           if (figures) write_trace_figures(r, trace_job->output);
+                           return particles::format_trace_summary(*trace_job, r);
                          }});
 }
 
@@ -236,7 +258,8 @@ CasePlan plan_case(const fs::path& case_file) {
   top.get("output", output);
   top.get("input", input);
   Section phantom(root["phantom"], where + ": phantom");
-  for (const char* key : {"phantom", "interpolate", "segment", "mesh", "solve"}) top.allow(key);
+  for (const char* key : {"phantom", "interpolate", "segment", "mesh", "solve", "trace"})
+    top.allow(key);
   top.finish();
   if (phantom.present() == !input.empty())
     fail("{}: give either 'input' (a CT volume or DICOM folder) or a 'phantom' section", where);
@@ -319,10 +342,9 @@ void run_case(const RunOptions& o) {
 void add_run_command(CLI::App& app) {
   auto [o, cmd] = add_stage<RunOptions>(
       app, "run",
-      "Run a case file: phantom or input CT → interpolate → segment → mesh → solve, each stage "
-      "writing its file in the case's output folder and skipped when its outputs are newer than "
-      "its "
-      "inputs and its settings are unchanged");
+      "Run a case file: phantom or input CT → interpolate → segment → mesh → solve → trace, "
+      "each stage writing its files in the case's output folder and skipped when its outputs "
+      "are newer than its inputs and its settings are unchanged");
   cmd->add_option("case", o->case_file, "case file (YAML), e.g. cases/phantom/case.yaml")
       ->required();
   cmd->add_flag("--force", o->force, "run every stage, even those that are up to date");

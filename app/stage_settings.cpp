@@ -1,5 +1,7 @@
 #include "app/stage_settings.h"
 
+#include <sstream>
+
 #include "core/error.h"
 
 namespace naris::app {
@@ -195,6 +197,69 @@ airflow::AirflowJob SolveSettings::resolve(const std::filesystem::path& base) co
                                               : ns::InletProfile::uniform;
   if (restart) j.restart = resolve_path(base, *restart);
   if (restart_mesh) j.restart_mesh = resolve_path(base, *restart_mesh);
+  return j;
+}
+
+TraceSettings::TraceSettings() {
+  table.add("mesh", mesh, "the mesh.h5 solved on (default: the one the solution names)");
+  table
+      .add("release", job.release,
+           "where particles start: dissertation (section 4.3.1's three groups on the naris: "
+           "ventral tip, midline, dorsal tip), grid (a regular grid on the naris), random "
+           "(flux-weighted on the naris), line (see line) or points (see points)")
+      .one_of({"dissertation", "grid", "random", "line", "points"});
+  table
+      .add("count", job.count,
+           "particles per group (dissertation), points across the naris (grid), particles "
+           "(random, line)")
+      .positive();
+  table.add("offset", job.offset_mm, "distance of release points from the naris wall (mm)")
+      .non_negative();
+  table.add("random_seed", job.seed, "seed of the random release (the same seed, the same points)");
+  table.add("line", job.line, "release line x0,y0,z0;x1,y1,z1 (mm)");
+  table.add("points", points, "release points: a CSV file of x,y,z (mm)[,group]");
+  table.add("diameter", diameter,
+            "particle diameters (µm), comma-separated, e.g. 0,1,5,10; 0 or none: massless tracers");
+  table.add("density", density, "particle density (kg/m³), one for all or one per diameter");
+  table.add("planes", planes,
+            "cross-section planes as distances (mm) from the airway's most anterior point along "
+            "the inlet → outlet axis, comma-separated, e.g. 33.5,44,54.5,65,75.5,85");
+  table.add("plane", job.planes, "a plane by point and normal p=x,y,z;n=nx,ny,nz (mm); repeatable");
+  table.add("gravity", job.gravity,
+            "down (−z: the patient's inferior in LPS, for an upright subject), none, or gx,gy,gz "
+            "(m/s²)");
+  table.add("drag", job.drag, "stokes or schiller-naumann").one_of({"stokes", "schiller-naumann"});
+  table.add("tolerance", job.tolerance, "local position error per step, in cell sizes").positive();
+  table.add("max_step", job.max_step, "cell sizes a step may move").positive();
+  table.add("max_time", job.max_time, "residence time at most (s)").positive();
+  table
+      .add("stagnation", job.stagnation, "a particle slower than this (in units of U_in) stagnates")
+      .non_negative();
+  table.add("path_spacing", job.path_spacing_mm, "spacing of recorded path points (mm)").positive();
+  table.add("max_paths", job.max_paths, "paths written for the first N particles").non_negative();
+  table.add("figures", figures, "the PNG figures of the paths and the crossings");
+}
+
+namespace {
+std::vector<double> number_list(const std::string& text, const char* what) {
+  std::vector<double> v;
+  std::string item;
+  std::istringstream in(text);
+  while (std::getline(in, item, ','))
+    if (!item.empty()) v.push_back(parse_setting_double(item, what));
+  return v;
+}
+}  // namespace
+
+particles::TraceJob TraceSettings::resolve(const std::filesystem::path& base) const {
+  particles::TraceJob j = job;
+  if (mesh) j.mesh = resolve_path(base, *mesh);
+  if (points) j.points = resolve_path(base, *points);
+  if (table.given("points") && job.release != "points") fail("points needs release: points");
+  if (table.given("line") && job.release != "line") fail("line needs release: line");
+  j.diameters_um = number_list(diameter, "diameter");
+  j.densities = number_list(density, "density");
+  j.plane_distances_mm = number_list(planes, "planes");
   return j;
 }
 

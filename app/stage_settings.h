@@ -11,6 +11,7 @@
 #include "mesh/image/image_jobs.h"
 #include "mesh/pipeline/mesh_job.h"
 #include "solver/airflow/airflow_job.h"
+#include "solver/particles/trace_job.h"
 
 namespace naris::app {
 
@@ -54,6 +55,14 @@ struct SolveSettings : StageSettings<airflow::AirflowJob> {
   bool verbose = job.nonlinear.log_iterations;
   SolveSettings();
   airflow::AirflowJob resolve(const std::filesystem::path& base = {}) const;
+};
+
+struct TraceSettings : StageSettings<particles::TraceJob> {
+  std::string diameter, density = "1000", planes;
+  std::optional<std::string> mesh, points;
+  bool figures = true;
+  TraceSettings();
+  particles::TraceJob resolve(const std::filesystem::path& base = {}) const;
 };
 
 }  // namespace naris::app

@@ -9,6 +9,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "postproc/figures/canvas.h"
 
 namespace naris::figures {
 namespace {
@@ -37,25 +38,14 @@ void write_png(const LinePlot& plot, const std::filesystem::path& path, int widt
   const double pad = 0.06 * (y1 - y0);
   y0 -= pad, y1 += pad;
 
-  std::unique_ptr<cairo_surface_t, void (*)(cairo_surface_t*)> surface(
-      cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height), &cairo_surface_destroy);
-  std::unique_ptr<cairo_t, void (*)(cairo_t*)> owner(cairo_create(surface.get()), &cairo_destroy);
-  cairo_t* cr = owner.get();
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_paint(cr);
+  const Canvas canvas(width, height);
+  cairo_t* cr = canvas.cr();
   const double left = 90, right = width - 30, top = 50, bottom = height - 70;
   auto px = [&](double x) { return left + (x - x0) / (x1 - x0) * (right - left); };
   auto py = [&](double y) { return bottom - (y - y0) / (y1 - y0) * (bottom - top); };
 
-  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
   auto text = [&](double x, double y, const std::string& s, double size, double align_x,
-                  double align_y) {
-    cairo_set_font_size(cr, size);
-    cairo_text_extents_t e;
-    cairo_text_extents(cr, s.c_str(), &e);
-    cairo_move_to(cr, x - align_x * e.width - e.x_bearing, y - align_y * e.height - e.y_bearing);
-    cairo_show_text(cr, s.c_str());
-  };
+                  double align_y) { canvas.text(x, y, s, size, align_x, align_y); };
 
   // Grid, ticks and labels.
   cairo_set_line_width(cr, 1.0);
@@ -144,10 +134,7 @@ void write_png(const LinePlot& plot, const std::filesystem::path& path, int widt
     ly += 20;
   }
 
-  AtomicOutput out(path);
-  if (cairo_surface_write_to_png(surface.get(), out.temp_path().c_str()) != CAIRO_STATUS_SUCCESS)
-    fail("{}: cannot write the PNG", path.string());
-  out.commit();
+  canvas.write_png(path);
 }
 
 }  // namespace naris::figures

@@ -130,9 +130,13 @@ void write_solution_h5(const SolutionState& s, const fs::path& path, const MeshC
     attribute(file.get(), "viscosity", s.viscosity, path);
     write_fields(file.get(), "velocity_nondimensional", "pressure_nondimensional", s.field, 1.0,
                  1.0, path);
-    if (mesh)
+    if (mesh) {
       write_fields(file.get(), "velocity", "pressure", s.field, s.u_in, s.density * s.u_in * s.u_in,
                    path);
+      write_string_attribute(
+          file.get(), "mesh_file",
+          fs::relative(fs::absolute(mesh_file), fs::absolute(path).parent_path()).string(), path);
+    }
     const ContinuationState& c = s.continuation;
     if (c.next_step > 0.0) {
       attribute(file.get(), "next_step", c.next_step, path);
@@ -163,6 +167,9 @@ SolutionState read_solution_h5(const fs::path& path) {
   s.density = number_attribute(file.get(), "density", path);
   s.viscosity = number_attribute(file.get(), "viscosity", path);
   s.field = read_fields(file.get(), "velocity_nondimensional", "pressure_nondimensional", path);
+  if (H5Aexists(file.get(), "mesh_file") > 0)
+    s.mesh_file = fs::absolute(path).parent_path() /
+                  read_string_attribute(file.get(), "mesh_file", path, kKind);
   if (H5Aexists(file.get(), "next_step") > 0) {
     ContinuationState& c = s.continuation;
     c.next_step = number_attribute(file.get(), "next_step", path);

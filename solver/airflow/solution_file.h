@@ -6,7 +6,8 @@
 // geometry from the mesh file, so ParaView opens it.
 //
 //   /  attributes format = "naris-solution", version, reynolds, target_reynolds, u_in (m/s),
-//      d_in_mm, density, viscosity, mesh_fingerprint (hex), nodes
+//      d_in_mm, density, viscosity, mesh_fingerprint (hex), nodes, mesh_file (solution.h5 only:
+//      the mesh.h5, relative to this file's folder)
 //   /velocity_nondimensional [nodes, 3], /pressure_nondimensional [nodes]
 //   /velocity [nodes, 3] (m/s), /pressure [nodes] (Pa)             (solution.h5 only)
 //
@@ -35,6 +36,7 @@ struct SolutionState {
   double reynolds = 0.0, target_reynolds = 0.0;
   double u_in = 0.0, d_in_mm = 0.0, density = 0.0, viscosity = 0.0;
   std::uint64_t mesh_fingerprint = 0;
+  std::filesystem::path mesh_file;               // read: absolute, empty when the file names none
   continuation::ContinuationState continuation;  // written when next_step > 0
 };
 

@@ -259,6 +259,7 @@ TEST_F(Cli, EveryStageOptionIsACaseFileKeyWithTheSameDefault) {
   check("segment", naris::app::SegmentSettings().table);
   check("mesh", naris::app::MeshSettings().table);
   check("solve", naris::app::SolveSettings().table);
+  check("trace", naris::app::TraceSettings().table);
 }
 
 TEST_F(Cli, UnknownOptionIsAnError) {
@@ -527,6 +528,13 @@ TEST_F(CliRunCase, BadCaseFilesAreClearErrors) {
       naris("run " +
             write_case(out + "phantom: {}\ninterpolate: {method: cubic}\n" + mesh).string()),
       "interpolate.method: 'cubic' is not one of hsr, linear, shape");
+  expect_clean_failure(
+      naris("run " + write_case(out + "phantom: {}\n" + mesh + "trace: {count: 5}\n").string()),
+      "the trace stage needs a solve section");
+  expect_clean_failure(naris("run " + write_case(out + "phantom: {}\n" + mesh +
+                                                 "solve: {}\ntrace: {release: rain}\n")
+                                          .string()),
+                       "trace.release: 'rain' is not one of");
 }
 
 TEST_F(Cli, SolvesTheFlowThroughACutBall) {
@@ -873,3 +881,65 @@ TEST_F(Cli, SolveBadInput) {
 }
 
 }  // namespace
+
+// naris trace on the cut ball's flow: every particle ends with one fate, none is lost, and two
+// ranks write the same particles and crossings as one.
+TEST_F(Cli, TracesTheCutBallOnOneAndTwoRanks) {
+  const fs::path mesh = dir_ / "in" / "mesh.h5", flow = dir_ / "in" / "flow";
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
+  ASSERT_EQ(naris("solve " + mesh.string() + " --re 20 -o " + flow.string()).status, 0);
+  const std::string args = "trace " + (flow / "solution.h5").string() +
+                           " --release random --count 10000 --planes 1.5,3 --diameter 3,30 ";
+  const fs::path one = dir_ / "one", two = dir_ / "two";
+  CliRun r = naris(args + "-o " + one.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = naris(args + "-o " + two.string(),
+            "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 " +
+                std::string(NARIS_MPIEXEC) + " -n 2 --oversubscribe ");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(summary(one, "particles"), 20000.0);
+  EXPECT_EQ(summary(one, "lost"), 0.0);
+  double ended = 0.0;
+  for (const char* fate : {"outlet", "inlet", "wall", "max-time", "stagnated"})
+    ended += summary(one, fate);
+  EXPECT_EQ(ended, 20000.0);
+  EXPECT_GT(summary(one, "wall"), 0.0);  // 30 µm particles settle onto the ball's floor
+  EXPECT_EQ(summary(two, "mpi_ranks"), 2.0);
+  for (const char* f : {"particles.csv", "crossings.csv", "fates.csv"}) {
+    std::ifstream a(one / f), b(two / f);
+    const std::string ta((std::istreambuf_iterator<char>(a)), {}),
+        tb((std::istreambuf_iterator<char>(b)), {});
+    EXPECT_GT(ta.size(), 100u) << f;
+    EXPECT_EQ(ta, tb) << f;
+  }
+  for (const char* f : {"paths.vtp", "deposits.vtp", "summary.json", "paths.png", "crossings.png"})
+    EXPECT_TRUE(fs::exists(one / f)) << f;
+}
+
+TEST_F(Cli, TraceBadInput) {
+  const fs::path mesh = dir_ / "in" / "mesh.h5", flow = dir_ / "in" / "flow";
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
+  ASSERT_EQ(naris("solve " + mesh.string() + " --re 5 -o " + flow.string()).status, 0);
+  const std::string trace =
+      "trace " + (flow / "solution.h5").string() + " -o " + (dir_ / "out").string() + " ";
+  // A solution of another mesh.
+  const fs::path in = nrrd("ball2.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const fs::path other = dir_ / "in" / "other.h5";
+  ASSERT_EQ(naris("mesh " + in.string() + " --inlet k=2 --outlet k=8 -o " + other.string()).status,
+            0);
+  expect_clean_failure(naris(trace + "--mesh " + other.string()), "was not solved on");
+  // A release point outside the airway, named.
+  const fs::path points = dir_ / "in" / "points.csv";
+  std::ofstream(points) << "x,y,z\n5.5,5.7,5.0\n50,50,50\n";
+  expect_clean_failure(naris(trace + "--release points --points " + points.string()),
+                       "release point 2 (50, 50, 50 mm) lies outside the airway");
+  expect_clean_failure(naris(trace + "--offset 20"), "too small for release groups 20 mm");
+  expect_clean_failure(naris(trace + "--diameter 5,-1"), "diameter -1 µm: must not be negative");
+  expect_clean_failure(naris(trace + "--diameter 5 --density -3"),
+                       "density -3 kg/m³: must be positive");
+  expect_clean_failure(naris(trace + "--planes 500"), "plane 500 mm misses the airway");
+  expect_clean_failure(naris(trace + "--plane \"p=0,0,-40;n=0,0,1\""), "misses the airway");
+  expect_clean_failure(naris(trace + "--release grid --count 0"), "must be positive");
+  expect_clean_failure(naris(trace + "--points " + points.string()),
+                       "points needs release: points");
+}

@@ -1,0 +1,79 @@
+// Inertial impaction in a 90° bend against Pui, Romay-Novas & Liu (1987), laminar (VERIFICATION.md
+// §6): a tube of diameter D bent at R_b = 5.7 D/2, meshed by MVE from the sampled torus at
+// several resolutions, the steady laminar flow solved by naris at Re 1000 with a developed inlet
+// profile, flux-weighted particles, Stokes drag. Stk = ρ_p d² C_c Ū / (9 μ D) = τ Ū / (D/2).
+// Prints one row per resolution and Stokes number.
+//
+//   bench_deposition [particles = 10000] [cells across D ...= 14 20 28]
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "core/log.h"
+#include "solver/nonlinear/navier_stokes_solver.h"
+#include "solver/ns/boundary_conditions.h"
+#include "solver/parallel/petsc.h"
+#include "solver/particles/mesh_flow.h"
+#include "solver/particles/release.h"
+#include "solver/particles/tracker.h"
+#include "tests/solver/meshes.h"
+
+using namespace naris;
+using namespace naris::particles;
+
+int main(int argc, char** argv) {
+  petsc::Session session;
+  set_verbosity(Verbosity::quiet);
+  const int n = argc > 1 ? std::atoi(argv[1]) : 10000;
+  std::vector<int> resolutions;
+  for (int i = 2; i < argc; ++i) resolutions.push_back(std::atoi(argv[i]));
+  if (resolutions.empty()) resolutions = {14, 20, 28};
+  // Lengths in units of D (read as millimetres), the velocity in units of Ū (read as m/s).
+  const double a = 0.5, bend = 2.85, re = 1000.0;
+  std::printf(
+      "| cells across D | cells | Stk | deposited | Pui et al. | difference | particles | lost | "
+      "trace (s) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+  for (int across : resolutions) {
+    mve::MveOptions options;
+    options.side_patch[0] = "outlet";
+    options.side_patch[2] = "inlet";
+    auto s = [&](const Vec3& x) { return std::hypot(std::hypot(x[0], x[1]) - bend, x[2]); };
+    const HybridMesh m =
+        testing::mve_mesh_box([&](const Vec3& x) { return a - s(x); }, {0.0, 0.0, -0.6},
+                              {3.5, 3.5, 0.6}, 1.0 / across, options);
+    const ns::DirichletConditions bc = ns::airflow_conditions(m, ns::InletProfile::developed, 1.0);
+    ns::FlowField field;
+    for (double step : {100.0, 300.0, 600.0, re}) {
+      nonlinear::NonlinearReport report;
+      const ns::FlowField earlier = field;
+      field = nonlinear::solve_navier_stokes(m, ns::FlowProblem{step, {}, bc}, {}, &report,
+                                             step == 100.0 ? nullptr : &earlier);
+      if (!report.converged) {
+        std::fprintf(stderr, "the bend's flow did not converge at Re %g\n", step);
+        return 1;
+      }
+    }
+    const MeshFlow flow(m, field.velocity, {m.patch_id("inlet"), m.patch_id("outlet")});
+    const ReleaseSet seeds = flux_weighted_release(m, m.patch_id("inlet"), field.velocity, n, 1987);
+    TraceOptions o;
+    o.drag = DragLaw::stokes;  // Stk defines the particle
+    for (double stk : {0.1, 0.2, 0.3, 0.5}) {
+      const double d = 10e-6, cc = cunningham_factor(d, o.air.mean_free_path);
+      const ParticleKind kind{d, 18.0 * o.air.viscosity * (stk * a * 1e-3) / (d * d * cc)};
+      Stopwatch clock;
+      int counts[kFates] = {};
+      for (const Vec3& x : seeds.points)
+        ++counts[static_cast<int>(
+            track(flow, {x, std::nullopt, flow.locate(x)}, kind, o, {}, false).fate)];
+      const double eta = counts[static_cast<int>(Fate::wall)] / double(n);
+      const double q = stk / 0.171;
+      const double pui = 1.0 - std::pow(1.0 + std::pow(q, 0.452 * q + 2.242), -1.0);
+      std::printf("| %d | %zu | %.1f | %.3f | %.3f | %+.3f | %d | %d | %.1f |\n", across,
+                  m.cell_count(), stk, eta, pui, eta - pui, n, counts[static_cast<int>(Fate::lost)],
+                  clock.seconds());
+      std::fflush(stdout);
+    }
+  }
+}
