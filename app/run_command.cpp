@@ -249,7 +249,6 @@ CasePlan plan_case(const fs::path& case_file) {
   const YAML::Node root = load_case(case_file);
   const std::string where = case_file.filename().string();
   const fs::path base = fs::absolute(case_file).parent_path();
-  auto resolve = [&](const fs::path& p) { return p.is_absolute() ? p : base / p; };
   CasePlan plan;
   Section top(root, where);
   std::string output = "results", input;
@@ -264,8 +263,8 @@ CasePlan plan_case(const fs::path& case_file) {
   if (phantom.present() == !input.empty())
     fail("{}: give either 'input' (a CT volume or DICOM folder) or a 'phantom' section", where);
   if (!present(root["mesh"])) fail("{}: the case has no 'mesh' section", where);
-  plan.out = resolve(output);
-  const fs::path ct = input.empty() ? plan.out / "ct.nrrd" : resolve(input);
+  plan.out = resolve_path(base, output);
+  const fs::path ct = input.empty() ? plan.out / "ct.nrrd" : resolve_path(base, input);
   if (!input.empty() && !fs::exists(ct)) fail("{}: input {} does not exist", where, ct.string());
   if (phantom.present()) plan_phantom(phantom, root["phantom"], ct, plan);
   const fs::path image = plan_image_stages(root, where, ct, plan);

@@ -50,8 +50,10 @@ void PieceSolves::checkpoint(double reynolds, const ns::FlowField& field,
                              const continuation::ContinuationState& state) {
   SolutionState s = state_at(field, reynolds);  // collective
   // The scalars; the earlier field gathered from the pieces, not copied.
-  s.continuation = {
-      state.next_step, state.pseudo_time, state.earlier_reynolds, {}, state.arclength_step};
+  s.continuation = {.next_step = state.next_step,
+                    .pseudo_time = state.pseudo_time,
+                    .earlier_reynolds = state.earlier_reynolds,
+                    .arclength_step = state.arclength_step};
   if (state.earlier_reynolds > 0.0)
     s.continuation.earlier = ns::gather_field(state.earlier, numbering_, PETSC_COMM_WORLD, 0);
   if (writer()) write_solution_h5(s, files_.checkpoint);

@@ -34,6 +34,7 @@ struct InletShape {
   bool contains(const Vec3& x) const;  // x's projection lies on the patch
   double distance_to_outline(const Vec3& x) const;
 };
+// Any planar patch (the outlet too); throws naris::Error when the patch has no faces.
 InletShape inlet_shape(const HybridMesh& mesh, int patch, const Vec3& up);
 
 // Section 4.3.1's three groups on the long axis of the naris, each `count` points at least

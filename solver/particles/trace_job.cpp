@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "core/error.h"
@@ -20,11 +21,6 @@ namespace {
 
 namespace fs = std::filesystem;
 constexpr double kMm = 1e-3;
-
-// The solver's open boundaries; every other patch is a no-slip wall.
-bool open_patch(const std::string& name) {
-  return name == "inlet" || name == "outlet";
-}
 
 Vec3 parse_vector(const std::string& text, const std::string& what) {
   std::string t = text;
@@ -42,28 +38,16 @@ Vec3 gravity_of(const std::string& text) {
   return parse_vector(text, "gravity");
 }
 
-Vec3 patch_centroid(const HybridMesh& m, int patch) {
-  Vec3 c = Vec3::Zero();
-  double area = 0.0;
-  for_each_boundary_face(m, [&](std::span<const NodeId> ids, std::int32_t p) {
-    if (p != patch) return;
-    const double a = polygon_area(m, ids);
-    Vec3 centre = Vec3::Zero();
-    for (NodeId v : ids) centre += m.nodes[v];
-    c += a * centre / static_cast<double>(ids.size());
-    area += a;
-  });
-  return c / area;
-}
-
 // The planes (m), each checked to cut the airway.
-std::vector<Plane> make_planes(const TraceJob& job, const HybridMesh& m, int inlet, int outlet,
+// `naris` is the inlet's shape (none without an inlet patch).
+std::vector<Plane> make_planes(const TraceJob& job, const HybridMesh& m,
+                               const std::optional<InletShape>& naris, int outlet, const Vec3& up,
                                std::vector<std::string>& labels) {
   std::vector<Plane> planes;
   if (!job.plane_distances_mm.empty()) {
-    if (inlet < 0 || outlet < 0)
+    if (!naris || outlet < 0)
       fail("planes by distance need the inlet and outlet patches (the anterior–posterior axis)");
-    const Vec3 axis = (patch_centroid(m, outlet) - patch_centroid(m, inlet)).normalized();
+    const Vec3 axis = (inlet_shape(m, outlet, up).centre - naris->centre).normalized();
     double tip = std::numeric_limits<double>::infinity();
     for (const Vec3& x : m.nodes) tip = std::min(tip, axis.dot(x));
     for (double s : job.plane_distances_mm) {
@@ -89,13 +73,13 @@ std::vector<Plane> make_planes(const TraceJob& job, const HybridMesh& m, int inl
 }
 
 ReleaseSet make_release(const TraceJob& job, const HybridMesh& m, int inlet,
-                        std::span<const Vec3> velocity, const Vec3& up, bool& on_inlet) {
+                        const std::optional<InletShape>& naris, std::span<const Vec3> velocity,
+                        bool& on_inlet) {
   on_inlet = job.release != "points" && job.release != "line";
-  if (on_inlet && inlet < 0) fail("release '{}' needs the mesh's inlet patch", job.release);
+  if (on_inlet && !naris) fail("release '{}' needs the mesh's inlet patch", job.release);
   if (job.release == "dissertation")
-    return dissertation_groups(inlet_shape(m, inlet, up), job.offset_mm * kMm, job.count);
-  if (job.release == "grid")
-    return grid_release(inlet_shape(m, inlet, up), job.count, job.offset_mm * kMm);
+    return dissertation_groups(*naris, job.offset_mm * kMm, job.count);
+  if (job.release == "grid") return grid_release(*naris, job.count, job.offset_mm * kMm);
   if (job.release == "random")
     return flux_weighted_release(m, inlet, velocity, job.count,
                                  static_cast<std::uint64_t>(job.seed));
@@ -175,10 +159,10 @@ TraceResult run_trace_job(const TraceJob& job) {
   if (mesh_file.empty())
     fail("{}: the solution names no mesh file; give the mesh", job.solution.string());
   const HybridMesh mesh = read_mesh_h5(mesh_file);
-  if (airflow::mesh_fingerprint(mesh) != state.mesh_fingerprint ||
-      mesh.nodes.size() != state.field.velocity.size())
+  const std::uint64_t fingerprint = airflow::mesh_fingerprint(mesh);
+  if (fingerprint != state.mesh_fingerprint || mesh.nodes.size() != state.field.velocity.size())
     fail("{} was not solved on {} (mesh fingerprints {:016x} and {:016x})", job.solution.string(),
-         mesh_file.string(), state.mesh_fingerprint, airflow::mesh_fingerprint(mesh));
+         mesh_file.string(), state.mesh_fingerprint, fingerprint);
   std::vector<Vec3> velocity(state.field.velocity.begin(), state.field.velocity.end());
   for (Vec3& u : velocity) u *= state.u_in;
 
@@ -209,16 +193,18 @@ TraceResult run_trace_job(const TraceJob& job) {
 
   std::vector<int> open;
   for (std::size_t p = 0; p < mesh.patch_names.size(); ++p)
-    if (open_patch(mesh.patch_names[p])) open.push_back(static_cast<int>(p));
+    if (is_open_patch(mesh.patch_names[p])) open.push_back(static_cast<int>(p));
   const int inlet = mesh.patch_id("inlet"), outlet = mesh.patch_id("outlet");
-  std::vector<std::string> plane_labels;
-  const std::vector<Plane> planes = make_planes(job, mesh, inlet, outlet, plane_labels);
   const Vec3 up = o.gravity.norm() > 0.0 ? Vec3(-o.gravity.normalized()) : Vec3::UnitZ();
+  std::optional<InletShape> naris;
+  if (inlet >= 0) naris = inlet_shape(mesh, inlet, up);
+  std::vector<std::string> plane_labels;
+  const std::vector<Plane> planes = make_planes(job, mesh, naris, outlet, up, plane_labels);
   bool on_inlet = false;
-  ReleaseSet release = make_release(job, mesh, inlet, velocity, up, on_inlet);
+  ReleaseSet release = make_release(job, mesh, inlet, naris, velocity, on_inlet);
   const MeshFlow flow(mesh, velocity, open);
   // Seeds on the inlet move a tenth of a micrometre inside, off the boundary face.
-  const Vec3 inward = on_inlet ? Vec3(-inlet_shape(mesh, inlet, up).normal) : Vec3::Zero();
+  const Vec3 inward = on_inlet ? Vec3(-naris->normal) : Vec3::Zero();
   std::vector<int> start_cell(release.points.size());
   for (std::size_t i = 0; i < release.points.size(); ++i) {
     if (on_inlet) release.points[i] += 1e-7 * inward;
@@ -233,7 +219,7 @@ TraceResult run_trace_job(const TraceJob& job) {
   TraceResult result;
   result.patch_names = mesh.patch_names;
   for (std::size_t p = 0; p < mesh.patch_names.size(); ++p) {
-    if (open_patch(mesh.patch_names[p]) || mesh.patch_names[p] == "wall") continue;
+    if (is_open_patch(mesh.patch_names[p]) || mesh.patch_names[p] == "wall") continue;
     Vec3 lo = Vec3::Constant(1e300), hi = -lo;
     for_each_boundary_face(mesh, [&](std::span<const NodeId> ids, std::int32_t q) {
       if (q != static_cast<int>(p)) return;
@@ -356,7 +342,7 @@ TraceResult run_trace_job(const TraceJob& job) {
   result.planes = planes;
   result.plane_labels = plane_labels;
   for_each_boundary_face(mesh, [&](std::span<const NodeId> ids, std::int32_t p) {
-    if (open_patch(mesh.patch_names[static_cast<std::size_t>(p)])) return;
+    if (is_open_patch(mesh.patch_names[static_cast<std::size_t>(p)])) return;
     for (std::size_t k = 1; k + 1 < ids.size(); ++k)
       result.wall.push_back({mesh.nodes[ids[0]], mesh.nodes[ids[k]], mesh.nodes[ids[k + 1]]});
   });

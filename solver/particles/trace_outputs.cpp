@@ -160,7 +160,7 @@ void write_trace_outputs(const TraceData& d) {
   std::vector<int> wall_patches;
   for (std::size_t p = 0; p < d.mesh.patch_names.size(); ++p) {
     const std::string& n = d.mesh.patch_names[p];
-    if (n != "inlet" && n != "outlet") wall_patches.push_back(static_cast<int>(p));
+    if (!is_open_patch(n)) wall_patches.push_back(static_cast<int>(p));
   }
   {
     std::vector<std::string> columns{"group", "diameter_um", "density_kg_m3", "released"};

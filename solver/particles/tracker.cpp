@@ -68,9 +68,8 @@ Step inertial_step(const FlowDomain& flow, const Vec3& x, const Vec3& v, const V
 Fate fate_of_patch(const FlowDomain& flow, int patch) {
   if (patch < 0) return Fate::lost;
   const std::string& name = flow.patch_names()[static_cast<std::size_t>(patch)];
-  if (name == "outlet") return Fate::outlet;
-  if (name == "inlet") return Fate::inlet;
-  return Fate::wall;
+  if (!is_open_patch(name)) return Fate::wall;
+  return name == "outlet" ? Fate::outlet : Fate::inlet;
 }
 
 void record_crossings(std::span<const Plane> planes, const Vec3& a, const Vec3& b, double ta,

@@ -23,6 +23,11 @@
 namespace naris::particles {
 
 enum class Fate { outlet, inlet, wall, max_time, stagnated, lost };
+
+// The solver's open boundaries, "inlet" and "outlet"; every other patch is a no-slip wall.
+inline bool is_open_patch(const std::string& name) {
+  return name == "inlet" || name == "outlet";
+}
 inline constexpr int kFates = 6;
 const char* fate_name(Fate fate);
 

@@ -237,6 +237,7 @@ TEST_F(ReynoldsContinuationTest, CheckpointsRecordWhereTheContinuationGoesNext) 
   FakeSolves pseudo;
   ReynoldsContinuation d(settings(5.0, 300.0), pseudo);
   d.run();
+  ASSERT_FALSE(pseudo.states.empty());
   for (const auto& s : pseudo.states) {
     EXPECT_TRUE(s.pseudo_time);
     EXPECT_EQ(s.earlier_reynolds, 0.0);
