@@ -28,6 +28,8 @@ void add_interpolate_command(CLI::App& app);
 void add_mesh_command(CLI::App& app);
 void add_solve_command(CLI::App& app);
 void add_trace_command(CLI::App& app);
+void add_planes_command(CLI::App& app);
+void add_compare_command(CLI::App& app);
 void add_eog_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_segment_command(CLI::App& app);

@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
   naris::app::add_mesh_command(app);
   naris::app::add_solve_command(app);
   naris::app::add_trace_command(app);
+  naris::app::add_planes_command(app);
+  naris::app::add_compare_command(app);
   naris::app::add_eog_command(app);
   naris::app::add_run_command(app);
   try {

@@ -1,6 +1,7 @@
-// `naris run case.yaml`: the stages of a case, from the CT (or the phantom) to the flow, one
-// file (or folder) each. A stage is skipped when its outputs are newer than its inputs and its
-// settings are the ones it last ran with (kept in <output>/.naris-run/); `--force` runs everything.
+// `naris run case.yaml`: the stages of a case, from the CT (or the phantom) to the flow, its
+// particle paths and its cross-sections, one file (or folder) each. A stage is skipped when its
+// outputs are newer than its inputs and its settings are the ones it last ran with (kept in
+// <output>/.naris-run/); `--force` runs everything.
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
@@ -24,6 +25,7 @@
 #include "mesh/image/phantom.h"
 #include "mesh/image/read_volume.h"
 #include "mesh/pipeline/mesh_job.h"
+#include "postproc/report/report.h"
 #include "solver/parallel/petsc.h"
 
 namespace naris::app {
@@ -123,7 +125,7 @@ struct RunOptions {
 // What a case file asks for: its stages in order, each with its files and settings.
 struct CasePlan {
   std::string name;
-  fs::path out;
+  fs::path case_file, out;
   std::vector<Stage> stages;
   std::optional<int> phantom_subject;  // the phantom knows its exact airway
   fs::path airway;                     // the segmentation, when the case segments
@@ -206,7 +208,8 @@ void plan_flow_stages(const YAML::Node& root, const std::string& where, const fs
          return format_mesh_summary(*job, r);
        }});
   if (!present(root["solve"])) {
-    if (present(root["trace"])) fail("{}: the trace stage needs a solve section", where);
+    for (const char* stage : {"trace", "planes"})
+      if (present(root[stage])) fail("{}: the {} stage needs a solve section", where, stage);
     return;
   }
   SolveSettings solve;
@@ -224,24 +227,63 @@ void plan_flow_stages(const YAML::Node& root, const std::string& where, const fs
                            return airflow::format_airflow_summary(*job,
                                                                   airflow::run_airflow_job(*job));
                          }});
-  if (!present(root["trace"])) return;
-  auto trace = std::make_shared<TraceSettings>();
-  trace->table.read(root["trace"], where + ": trace");
-  auto trace_job = std::make_shared<particles::TraceJob>(trace->resolve(base));
-  trace_job->solution = job->output / "solution.h5";
-  trace_job->output = plan.out / "trace";
-  std::vector<fs::path> trace_inputs{trace_job->solution};
-  if (!trace_job->points.empty()) trace_inputs.push_back(trace_job->points);
-  if (trace_job->mesh) trace_inputs.push_back(*trace_job->mesh);
-  plan.stages.push_back({"trace",
-                         trace_inputs,
-                         {trace_job->output / "summary.json"},
-                         dump(root["trace"]),
-                         [trace_job, figures = trace->figures] {
-                           const particles::TraceResult r = particles::run_trace_job(*trace_job);
-                           if (figures) write_trace_figures(r, trace_job->output);
-                           return particles::format_trace_summary(*trace_job, r);
+  const fs::path solution = job->output / "solution.h5";
+  fs::path crossings;
+  if (present(root["trace"])) {
+    auto trace = std::make_shared<TraceSettings>();
+    trace->table.read(root["trace"], where + ": trace");
+    auto trace_job = std::make_shared<particles::TraceJob>(trace->resolve(base));
+    trace_job->solution = solution;
+    trace_job->output = plan.out / "trace";
+    crossings = trace_job->output / "crossings.csv";
+    std::vector<fs::path> trace_inputs{trace_job->solution};
+    if (!trace_job->points.empty()) trace_inputs.push_back(trace_job->points);
+    if (trace_job->mesh) trace_inputs.push_back(*trace_job->mesh);
+    plan.stages.push_back({"trace",
+                           trace_inputs,
+                           {trace_job->output / "summary.json"},
+                           dump(root["trace"]),
+                           [trace_job, figures = trace->figures] {
+                             const particles::TraceResult r = particles::run_trace_job(*trace_job);
+                             if (figures) write_trace_figures(r, trace_job->output);
+                             return particles::format_trace_summary(*trace_job, r);
+                           }});
+  }
+  if (!present(root["planes"])) return;
+  PlanesSettings planes;
+  planes.table.read(root["planes"], where + ": planes");
+  auto planes_job = std::make_shared<planes::PlanesJob>(planes.resolve(base));
+  planes_job->solution = solution;
+  planes_job->output = plan.out / "planes";
+  // The trace's crossings are drawn on the planes unless the section names another file.
+  if (!planes.crossings && !crossings.empty()) planes_job->crossings = crossings;
+  std::vector<fs::path> planes_inputs{solution};
+  if (!planes_job->crossings.empty()) planes_inputs.push_back(planes_job->crossings);
+  if (!planes_job->mesh.empty()) planes_inputs.push_back(planes_job->mesh);
+  plan.stages.push_back({"planes",
+                         planes_inputs,
+                         {planes_job->output / "summary.json"},
+                         dump(root["planes"]),
+                         [planes_job] {
+                           return planes::format_planes_summary(
+                               *planes_job, planes::run_planes_job(*planes_job));
                          }});
+  // The report gathers the stages' tables and figures with the case file.
+  std::vector<fs::path> report_inputs{job->output / "summary.json",
+                                      planes_job->output / "summary.json"};
+  if (!crossings.empty()) report_inputs.push_back(plan.out / "trace" / "summary.json");
+  plan.stages.push_back(
+      {"report",
+       report_inputs,
+       {plan.out / "report.html"},
+       dump(root["planes"]),
+       [out = plan.out, name = plan.name, case_file = plan.case_file] {
+         std::ifstream in(case_file);
+         std::stringstream text;
+         text << in.rdbuf();
+         report::write_report(report::case_report(out, name, text.str(), NARIS_VERSION), out);
+         return fmt::format("naris report: {} and report.md", (out / "report.html").string());
+       }});
 }
 
 // Every setting of every stage read and checked, before anything runs.
@@ -250,6 +292,7 @@ CasePlan plan_case(const fs::path& case_file) {
   const std::string where = case_file.filename().string();
   const fs::path base = fs::absolute(case_file).parent_path();
   CasePlan plan;
+  plan.case_file = fs::absolute(case_file);
   Section top(root, where);
   std::string output = "results", input;
   plan.name = case_file.parent_path().filename().string();
@@ -257,7 +300,7 @@ CasePlan plan_case(const fs::path& case_file) {
   top.get("output", output);
   top.get("input", input);
   Section phantom(root["phantom"], where + ": phantom");
-  for (const char* key : {"phantom", "interpolate", "segment", "mesh", "solve", "trace"})
+  for (const char* key : {"phantom", "interpolate", "segment", "mesh", "solve", "trace", "planes"})
     top.allow(key);
   top.finish();
   if (phantom.present() == !input.empty())
@@ -341,7 +384,8 @@ void run_case(const RunOptions& o) {
 void add_run_command(CLI::App& app) {
   auto [o, cmd] = add_stage<RunOptions>(
       app, "run",
-      "Run a case file: phantom or input CT → interpolate → segment → mesh → solve → trace, "
+      "Run a case file: phantom or input CT → interpolate → segment → mesh → solve → trace → "
+      "planes → report, "
       "each stage writing its files in the case's output folder and skipped when its outputs "
       "are newer than its inputs and its settings are unchanged");
   cmd->add_option("case", o->case_file, "case file (YAML), e.g. cases/phantom/case.yaml")

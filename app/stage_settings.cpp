@@ -200,6 +200,19 @@ airflow::AirflowJob SolveSettings::resolve(const std::filesystem::path& base) co
   return j;
 }
 
+namespace {
+// Planes by point and normal, and the anterior–posterior axis of planes by distance (trace and
+// planes alike).
+void add_plane_settings(Settings& table, std::vector<std::string>& planes, std::string& axis) {
+  table.add("plane", planes, "a plane by point and normal p=x,y,z;n=nx,ny,nz (mm); repeatable");
+  table
+      .add("axis", axis,
+           "the anterior–posterior axis of planes by distance: inlet-outlet (from the inlet's "
+           "centroid to the outlet's) or an image axis x, y, z, -x, -y, -z")
+      .one_of({"inlet-outlet", "x", "y", "z", "-x", "-y", "-z"});
+}
+}  // namespace
+
 TraceSettings::TraceSettings() {
   table.add("mesh", mesh, "the mesh.h5 solved on (default: the one the solution names)");
   table
@@ -223,8 +236,8 @@ TraceSettings::TraceSettings() {
   table.add("density", density, "particle density (kg/m³), one for all or one per diameter");
   table.add("planes", planes,
             "cross-section planes as distances (mm) from the airway's most anterior point along "
-            "the inlet → outlet axis, comma-separated, e.g. 33.5,44,54.5,65,75.5,85");
-  table.add("plane", job.planes, "a plane by point and normal p=x,y,z;n=nx,ny,nz (mm); repeatable");
+            "the axis, comma-separated, e.g. 33.5,44,54.5,65,75.5,85");
+  add_plane_settings(table, job.planes, job.plane_axis);
   table.add("gravity", job.gravity,
             "down (−z: the patient's inferior in LPS, for an upright subject), none, or gx,gy,gz "
             "(m/s²)");
@@ -260,6 +273,33 @@ particles::TraceJob TraceSettings::resolve(const std::filesystem::path& base) co
   j.diameters_um = number_list(diameter, "diameter");
   j.densities = number_list(density, "density");
   j.plane_distances_mm = number_list(planes, "planes");
+  return j;
+}
+
+PlanesSettings::PlanesSettings() {
+  table.add("mesh", mesh, "the mesh.h5 solved on (default: the one the solution names)");
+  table.add("at", at,
+            "planes at these distances (mm) from the airway's most anterior point along the axis, "
+            "comma-separated; empty: none");
+  add_plane_settings(table, job.planes, job.axis);
+  table
+      .add("smoothing", job.smoothing,
+           "width of the Gaussian that smooths the outline before its length is taken, in voxels")
+      .positive();
+  table.add("levels", job.levels, "speed bands and contour levels, 0 at the wall to the maximum")
+      .range(2, 64);
+  table.add("arrows", job.arrows_across, "secondary-velocity arrows across the section")
+      .range(2, 200);
+  table.add("crossings", crossings,
+            "crossings.csv of naris trace: the particles' crossing points drawn on the planes");
+  table.add("figures", job.figures, "a PNG and an SVG figure per plane");
+}
+
+planes::PlanesJob PlanesSettings::resolve(const std::filesystem::path& base) const {
+  planes::PlanesJob j = job;
+  if (mesh) j.mesh = resolve_path(base, *mesh);
+  if (crossings) j.crossings = resolve_path(base, *crossings);
+  j.distances_mm = number_list(at, "at");
   return j;
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // The settings tables of the stages that both a command and a case file run: interpolate,
-// segment, mesh and solve. Each holds the library's job with its defaults, the table bound to
-// it, and resolves the two into the job to run.
+// segment, mesh, solve, trace and planes. Each holds the library's job with its defaults, the table
+// bound to it, and resolves the two into the job to run.
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -10,6 +10,7 @@
 #include "app/settings.h"
 #include "mesh/image/image_jobs.h"
 #include "mesh/pipeline/mesh_job.h"
+#include "postproc/planes/planes_job.h"
 #include "solver/airflow/airflow_job.h"
 #include "solver/particles/trace_job.h"
 
@@ -63,6 +64,13 @@ struct TraceSettings : StageSettings<particles::TraceJob> {
   bool figures = true;
   TraceSettings();
   particles::TraceJob resolve(const std::filesystem::path& base = {}) const;
+};
+
+struct PlanesSettings : StageSettings<planes::PlanesJob> {
+  std::string at = "33.5,44,54.5,65,75.5,85";
+  std::optional<std::string> mesh, crossings;
+  PlanesSettings();
+  planes::PlanesJob resolve(const std::filesystem::path& base = {}) const;
 };
 
 }  // namespace naris::app

@@ -95,9 +95,19 @@ void write_mesh_h5(const HybridMesh& mesh, const fs::path& path) {
   write_xdmf(mesh, path);
 }
 
+std::string read_mesh_units(const fs::path& path) {
+  SilenceHdf5 quiet;
+  const H5Handle file = open_file(path, "naris-mesh", kFormatVersion, "a naris mesh file");
+  return read_string_attribute(file.get(), "units", path, "a naris mesh file");
+}
+
 HybridMesh read_mesh_h5(const fs::path& path) {
   SilenceHdf5 quiet;
   const H5Handle file = open_file(path, "naris-mesh", kFormatVersion, "a naris mesh file");
+  if (const std::string units =
+          read_string_attribute(file.get(), "units", path, "a naris mesh file");
+      units != "mm")
+    fail("{}: coordinates in '{}'; naris meshes are in mm", path.string(), units);
   HybridMesh mesh;
   std::istringstream names(
       read_string_attribute(file.get(), "patch_names", path, "a naris mesh file"));

@@ -14,6 +14,7 @@
 //
 // Node ids are 0-based. Every cell has positive volume.
 #include <filesystem>
+#include <string>
 
 #include "mesh/hybrid_mesh.h"
 
@@ -21,6 +22,9 @@ namespace naris {
 
 // Writes path and the sidecar path.replace_extension(".xdmf").
 void write_mesh_h5(const HybridMesh& mesh, const std::filesystem::path& path);
+// Throws naris::Error for a missing or foreign file, or one whose units are not millimetres.
 HybridMesh read_mesh_h5(const std::filesystem::path& path);
+// The file's `units` attribute alone (naris writes "mm").
+std::string read_mesh_units(const std::filesystem::path& path);
 
 }  // namespace naris

@@ -337,6 +337,14 @@ void write_boundary_vtp(const HybridMesh& mesh, const std::filesystem::path& pat
   run_writer(writer.Get(), path);
 }
 
+void write_vtp(vtkPolyData* data, const std::filesystem::path& path) {
+  auto writer = vtkSmartPointer<vtkXMLPolyDataWriter>::New();
+  writer->SetInputData(data);
+  writer->SetDataModeToAppended();
+  writer->SetCompressorTypeToZLib();
+  run_writer(writer.Get(), path);
+}
+
 void write_stl(const HybridMesh& mesh, const std::filesystem::path& path) {
   auto writer = vtkSmartPointer<vtkSTLWriter>::New();
   writer->SetInputData(boundary_polydata(mesh, true));

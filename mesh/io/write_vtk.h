@@ -10,6 +10,8 @@
 
 #include "mesh/hybrid_mesh.h"
 
+class vtkPolyData;
+
 namespace naris {
 
 // Cell arrays are given in the writer's cell order: tets, then pyramids, then hexes.
@@ -36,5 +38,7 @@ std::filesystem::path pvtu_piece_path(const std::filesystem::path& path, int pie
 void write_boundary_vtp(const HybridMesh& mesh, const std::filesystem::path& path,
                         const PointFields& face_fields = {});
 void write_stl(const HybridMesh& mesh, const std::filesystem::path& path);
+// Any polygonal dataset as .vtp (appended, zlib-compressed), written atomically.
+void write_vtp(vtkPolyData* data, const std::filesystem::path& path);
 
 }  // namespace naris

@@ -99,6 +99,12 @@ void write_png(const LinePlot& plot, const std::filesystem::path& path, int widt
       started = true;
     }
     cairo_stroke(cr);
+    cairo_set_dash(cr, nullptr, 0, 0);
+    for (std::size_t k : s.markers) {
+      if (k >= s.x.size() || !std::isfinite(s.y[k])) continue;
+      cairo_arc(cr, px(s.x[k]), py(s.y[k]), 6.0, 0.0, 2.0 * M_PI);
+      cairo_fill(cr);
+    }
   }
   cairo_set_dash(cr, nullptr, 0, 0);
   cairo_restore(cr);
@@ -119,18 +125,26 @@ void write_png(const LinePlot& plot, const std::filesystem::path& path, int widt
     if (!plot.arrow_label.empty()) text(ax + 8, top + 20, plot.arrow_label, 13, 0.0, 0.5);
   }
 
-  // Legend.
+  // Legend, inside the frame's lower right corner, as wide as its longest label.
+  double label_width = 0.0;
+  cairo_set_font_size(cr, 13);
+  for (const auto& s : plot.series) {
+    cairo_text_extents_t e;
+    cairo_text_extents(cr, s.label.c_str(), &e);
+    label_width = std::max(label_width, e.x_advance);
+  }
+  const double lx = right - label_width - 62;
   double ly = bottom - 20.0 * static_cast<double>(plot.series.size()) - 6;
   for (const auto& s : plot.series) {
     cairo_set_source_rgb(cr, s.rgb[0], s.rgb[1], s.rgb[2]);
     const double dash[] = {8.0, 5.0};
     cairo_set_dash(cr, dash, s.dashed ? 2 : 0, 0);
-    cairo_move_to(cr, right - 230, ly);
-    cairo_line_to(cr, right - 190, ly);
+    cairo_move_to(cr, lx, ly);
+    cairo_line_to(cr, lx + 40, ly);
     cairo_stroke(cr);
     cairo_set_dash(cr, nullptr, 0, 0);
     cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-    text(right - 182, ly, s.label, 13, 0.0, 0.5);
+    text(lx + 48, ly, s.label, 13, 0.0, 0.5);
     ly += 20;
   }
 

@@ -1,5 +1,5 @@
 #pragma once
-// Line plots as PNG (cairo): the response figures of chapter 5 and, later, profiles.
+// Line plots as PNG (cairo): the response figures of chapter 5 and profiles along the airway.
 #include <array>
 #include <filesystem>
 #include <optional>
@@ -13,6 +13,7 @@ struct Series {
   std::vector<double> x, y;
   bool dashed = false;
   std::array<double, 3> rgb{0.0, 0.0, 0.0};
+  std::vector<std::size_t> markers;  // points drawn as circles (a minimum, an event)
 };
 
 struct LinePlot {

@@ -24,44 +24,7 @@ Point3 cross(const Point3& a, const Point3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
-void legend(const Canvas& canvas, const std::vector<std::string>& groups, double x, double y) {
-  cairo_t* cr = canvas.cr();
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    const auto c = group_colour(static_cast<int>(g));
-    cairo_set_source_rgb(cr, c[0], c[1], c[2]);
-    cairo_rectangle(cr, x, y + 22.0 * static_cast<double>(g) - 6, 24, 12);
-    cairo_fill(cr);
-    cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-    canvas.text(x + 32, y + 22.0 * static_cast<double>(g), groups[g], 15, 0.0, 0.5);
-  }
-}
-
-// A scale bar of a round length near a fifth of `span_mm`.
-void scale_bar(const Canvas& canvas, double x, double y, double pixels_per_mm, double span_mm) {
-  cairo_t* cr = canvas.cr();
-  double length = std::pow(10.0, std::floor(std::log10(span_mm / 5.0)));
-  for (double m : {5.0, 2.0})
-    if (m * length <= span_mm / 5.0) {
-      length *= m;
-      break;
-    }
-  cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-  cairo_set_line_width(cr, 3.0);
-  cairo_move_to(cr, x, y);
-  cairo_line_to(cr, x + length * pixels_per_mm, y);
-  cairo_stroke(cr);
-  canvas.text(x + 0.5 * length * pixels_per_mm, y + 8, fmt::format("{:g} mm", length), 14, 0.5,
-              0.0);
-}
-
 }  // namespace
-
-std::array<double, 3> group_colour(int g) {
-  static const std::array<double, 3> palette[] = {
-      {0.84, 0.15, 0.16}, {0.12, 0.47, 0.71}, {0.17, 0.63, 0.17}, {1.00, 0.50, 0.05},
-      {0.58, 0.40, 0.74}, {0.55, 0.34, 0.29}, {0.89, 0.47, 0.76}, {0.50, 0.50, 0.50}};
-  return palette[static_cast<std::size_t>(g) % 8];
-}
 
 void write_path_figure(const PathFigure& f, const std::filesystem::path& path, int width,
                        int height) {
@@ -123,7 +86,7 @@ void write_path_figure(const PathFigure& f, const std::filesystem::path& path, i
   canvas.text(left, height - 40, f.caption, 14, 0.0, 0.5);
   canvas.text(left, height - 18, "screen right: " + f.right_label + ", up: " + f.up_label, 13, 0.0,
               0.5);
-  legend(canvas, f.groups, right + 30, top + 20);
+  group_legend(canvas, f.groups, right + 30, top + 20);
   scale_bar(canvas, right + 30, bottom - 20, scale, x1 - x0);
   canvas.write_png(path);
 }
@@ -184,7 +147,7 @@ void write_crossing_figure(const CrossingFigure& f, const std::filesystem::path&
   canvas.text(0.5 * (width - legend_width), 14, f.title, 20, 0.5, 0.0);
   canvas.text(20, height - 40, f.caption, 14, 0.0, 0.5);
   canvas.text(20, height - 18, f.u_label + " → right, " + f.v_label + " ↑", 13, 0.0, 0.5);
-  legend(canvas, f.groups, columns * panel_size + 20, header + 30);
+  group_legend(canvas, f.groups, columns * panel_size + 20, header + 30);
   scale_bar(canvas, columns * panel_size + 20, height - footer - 20, scale, span);
   canvas.write_png(path);
 }

@@ -39,7 +39,4 @@ struct CrossingFigure {
 void write_crossing_figure(const CrossingFigure& figure, const std::filesystem::path& path,
                            int panel_size = 420);
 
-// The colour of group g (a qualitative palette).
-std::array<double, 3> group_colour(int g);
-
 }  // namespace naris::figures

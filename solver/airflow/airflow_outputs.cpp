@@ -296,6 +296,8 @@ void write_summary_json(const AirflowJob& job, AirflowResult& r) {
       {"inlet_hydraulic_diameter_mm", significant(r.d_in_mm)},
       {"inlet_area_mm2", significant(r.inlet_area_mm2)},
       {"inlet_perimeter_mm", significant(r.inlet_perimeter_mm)},
+      // naris planes also reports the inlet's perimeter smoothed at the voxel scale.
+      {"reynolds_defined_on", "d_in = 4A/P with P the inlet outline as meshed (raw)"},
       {"viscosity_m2_s", significant(job.viscosity)},
       {"density_kg_m3", significant(job.density)},
       {"inlet_profile", profile_name(job)},

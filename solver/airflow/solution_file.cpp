@@ -8,6 +8,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hdf5_table.h"
+#include "mesh/io/mesh_h5.h"
 
 namespace naris::airflow {
 using continuation::ContinuationState;
@@ -200,6 +201,24 @@ SolutionState read_solution_h5(const fs::path& path) {
     }
   }
   return s;
+}
+
+SolvedMesh read_solved_mesh(const std::filesystem::path& solution,
+                            const std::filesystem::path& mesh_file) {
+  SolvedMesh r;
+  r.state = read_solution_h5(solution);
+  r.mesh_file = mesh_file.empty() ? r.state.mesh_file : mesh_file;
+  if (r.mesh_file.empty())
+    fail("{}: the solution names no mesh file; give the mesh", solution.string());
+  r.mesh = read_mesh_h5(r.mesh_file);
+  const std::uint64_t fingerprint = mesh_fingerprint(r.mesh);
+  if (fingerprint != r.state.mesh_fingerprint ||
+      r.mesh.nodes.size() != r.state.field.velocity.size())
+    fail("{} was not solved on {} (mesh fingerprints {:016x} and {:016x})", solution.string(),
+         r.mesh_file.string(), r.state.mesh_fingerprint, fingerprint);
+  r.velocity.assign(r.state.field.velocity.begin(), r.state.field.velocity.end());
+  for (Eigen::Vector3d& u : r.velocity) u *= r.state.u_in;
+  return r;
 }
 
 }  // namespace naris::airflow

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "mesh/hybrid_mesh.h"
 #include "solver/continuation/reynolds_continuation.h"
@@ -57,5 +58,16 @@ void write_solution_h5(const SolutionState& state, const std::filesystem::path& 
 
 // Throws naris::Error for a missing, unreadable or foreign file.
 SolutionState read_solution_h5(const std::filesystem::path& path);
+
+// A solution with the mesh it was solved on: `mesh_file` (default: the one the solution names),
+// checked by fingerprint; `velocity` in m/s. Throws naris::Error for a solution of another mesh.
+struct SolvedMesh {
+  SolutionState state;
+  std::filesystem::path mesh_file;
+  HybridMesh mesh;
+  std::vector<Eigen::Vector3d> velocity;
+};
+SolvedMesh read_solved_mesh(const std::filesystem::path& solution,
+                            const std::filesystem::path& mesh_file = {});
 
 }  // namespace naris::airflow

@@ -12,6 +12,7 @@
 #include "core/log.h"
 #include "mesh/io/mesh_h5.h"
 #include "mesh/patches/patches.h"
+#include "mesh/patches/section_planes.h"
 #include "solver/airflow/solution_file.h"
 #include "solver/particles/mesh_flow.h"
 #include "solver/particles/trace_outputs.h"
@@ -39,35 +40,15 @@ Vec3 gravity_of(const std::string& text) {
 }
 
 // The planes (m), each checked to cut the airway.
-// `naris` is the inlet's shape (none without an inlet patch).
 std::vector<Plane> make_planes(const TraceJob& job, const HybridMesh& m,
-                               const std::optional<InletShape>& naris, int outlet, const Vec3& up,
                                std::vector<std::string>& labels) {
+  const std::vector<SectionPlane> sections = section_planes(
+      m, job.plane_distances_mm.empty() ? SectionAxis{} : section_axis(m, job.plane_axis),
+      job.plane_distances_mm, job.planes);
   std::vector<Plane> planes;
-  if (!job.plane_distances_mm.empty()) {
-    if (!naris || outlet < 0)
-      fail("planes by distance need the inlet and outlet patches (the anterior–posterior axis)");
-    const Vec3 axis = (inlet_shape(m, outlet, up).centre - naris->centre).normalized();
-    double tip = std::numeric_limits<double>::infinity();
-    for (const Vec3& x : m.nodes) tip = std::min(tip, axis.dot(x));
-    for (double s : job.plane_distances_mm) {
-      planes.push_back({(tip + s) * axis * kMm, axis});
-      labels.push_back(fmt::format("{:g} mm", s));
-    }
-  }
-  for (const std::string& text : job.planes) {
-    const CutPlane c = parse_cut_plane(text);
-    if (c.index_plane) fail("plane '{}': give a plane as p=x,y,z;n=nx,ny,nz (mm)", text);
-    planes.push_back({c.point * kMm, c.normal});
-    labels.push_back(text);
-  }
-  for (std::size_t i = 0; i < planes.size(); ++i) {
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const Vec3& x : m.nodes) {
-      const double s = planes[i].normal.dot(x * kMm - planes[i].point);
-      lo = std::min(lo, s), hi = std::max(hi, s);
-    }
-    if (!(lo < 0.0 && hi > 0.0)) fail("plane {} misses the airway", labels[i]);
+  for (const SectionPlane& p : sections) {
+    planes.push_back({p.point * kMm, p.normal});
+    labels.push_back(p.label);
   }
   return planes;
 }
@@ -154,17 +135,11 @@ TraceResult run_trace_job(const TraceJob& job) {
     MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   }
   // Inputs, all checked before anything is written.
-  const airflow::SolutionState state = airflow::read_solution_h5(job.solution);
-  const fs::path mesh_file = job.mesh ? *job.mesh : state.mesh_file;
-  if (mesh_file.empty())
-    fail("{}: the solution names no mesh file; give the mesh", job.solution.string());
-  const HybridMesh mesh = read_mesh_h5(mesh_file);
-  const std::uint64_t fingerprint = airflow::mesh_fingerprint(mesh);
-  if (fingerprint != state.mesh_fingerprint || mesh.nodes.size() != state.field.velocity.size())
-    fail("{} was not solved on {} (mesh fingerprints {:016x} and {:016x})", job.solution.string(),
-         mesh_file.string(), state.mesh_fingerprint, fingerprint);
-  std::vector<Vec3> velocity(state.field.velocity.begin(), state.field.velocity.end());
-  for (Vec3& u : velocity) u *= state.u_in;
+  const airflow::SolvedMesh solved =
+      airflow::read_solved_mesh(job.solution, job.mesh ? *job.mesh : fs::path{});
+  const airflow::SolutionState& state = solved.state;
+  const HybridMesh& mesh = solved.mesh;
+  const std::vector<Vec3>& velocity = solved.velocity;
 
   TraceOptions o;
   o.tolerance = job.tolerance;
@@ -194,12 +169,12 @@ TraceResult run_trace_job(const TraceJob& job) {
   std::vector<int> open;
   for (std::size_t p = 0; p < mesh.patch_names.size(); ++p)
     if (is_open_patch(mesh.patch_names[p])) open.push_back(static_cast<int>(p));
-  const int inlet = mesh.patch_id("inlet"), outlet = mesh.patch_id("outlet");
+  const int inlet = mesh.patch_id("inlet");
   const Vec3 up = o.gravity.norm() > 0.0 ? Vec3(-o.gravity.normalized()) : Vec3::UnitZ();
   std::optional<InletShape> naris;
   if (inlet >= 0) naris = inlet_shape(mesh, inlet, up);
   std::vector<std::string> plane_labels;
-  const std::vector<Plane> planes = make_planes(job, mesh, naris, outlet, up, plane_labels);
+  const std::vector<Plane> planes = make_planes(job, mesh, plane_labels);
   bool on_inlet = false;
   ReleaseSet release = make_release(job, mesh, inlet, naris, velocity, on_inlet);
   const MeshFlow flow(mesh, velocity, open);
@@ -218,24 +193,16 @@ TraceResult run_trace_job(const TraceJob& job) {
   // Region patches: named wall patches (not "wall"), each as the box of its faces.
   TraceResult result;
   result.patch_names = mesh.patch_names;
-  for (std::size_t p = 0; p < mesh.patch_names.size(); ++p) {
-    if (is_open_patch(mesh.patch_names[p]) || mesh.patch_names[p] == "wall") continue;
-    Vec3 lo = Vec3::Constant(1e300), hi = -lo;
-    for_each_boundary_face(mesh, [&](std::span<const NodeId> ids, std::int32_t q) {
-      if (q != static_cast<int>(p)) return;
-      for (NodeId v : ids)
-        lo = lo.cwiseMin(mesh.nodes[v] * kMm), hi = hi.cwiseMax(mesh.nodes[v] * kMm);
-    });
-    if (lo[0] > hi[0]) continue;
+  for (const RegionBox& box : region_boxes(mesh)) {
     if (o.regions.size() == 32) {
       log_line(
           fmt::format("naris trace: more than 32 region patches; visits to '{}' and later "
                       "ones are not counted",
-                      mesh.patch_names[p]));
+                      mesh.patch_names[static_cast<std::size_t>(box.patch)]));
       break;
     }
-    o.regions.push_back({lo, hi});
-    result.region_patches.push_back(static_cast<int>(p));
+    o.regions.push_back({box.lo * kMm, box.hi * kMm});
+    result.region_patches.push_back(box.patch);
   }
 
   // Every ranks-th particle here; progress from rank 0's share.

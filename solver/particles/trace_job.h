@@ -30,9 +30,11 @@ struct TraceJob {
   // density given (one for all, or one per diameter).
   std::vector<double> diameters_um;
   std::vector<double> densities = {1000.0};
-  // Planes: distances (mm) from the airway's most anterior point along the inlet → outlet axis,
-  // and planes by point and normal ("p=x,y,z;n=nx,ny,nz", mm).
+  // Planes: distances (mm) from the airway's most anterior point along `plane_axis` (the inlet →
+  // outlet axis, or an image axis: section_planes.h), and planes by point and normal
+  // ("p=x,y,z;n=nx,ny,nz", mm).
   std::vector<double> plane_distances_mm;
+  std::string plane_axis = "inlet-outlet";
   std::vector<std::string> planes;
   std::string gravity = "down";  // down (−z, the patient's inferior in LPS), none, or gx,gy,gz m/s²
   std::string drag = "schiller-naumann";

@@ -16,23 +16,13 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json.h"
+#include "mesh/io/write_vtk.h"
 
 namespace naris::particles {
 namespace {
 
 namespace fs = std::filesystem;
 constexpr double kMm = 1e-3;
-
-void write_vtp(vtkPolyData* data, const fs::path& path) {
-  auto writer = vtkSmartPointer<vtkXMLPolyDataWriter>::New();
-  writer->SetInputData(data);
-  writer->SetDataModeToAppended();
-  writer->SetCompressorTypeToZLib();
-  AtomicOutput out(path);
-  writer->SetFileName(out.temp_path().c_str());
-  if (writer->Write() != 1) fail("{}: VTK could not write the file", path.string());
-  out.commit();
-}
 
 vtkSmartPointer<vtkIntArray> int_array(const char* name) {
   auto a = vtkSmartPointer<vtkIntArray>::New();

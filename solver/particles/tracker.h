@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "mesh/patches/section_planes.h"
 #include "solver/particles/flow_domain.h"
 #include "solver/particles/particle_physics.h"
 
@@ -24,10 +25,6 @@ namespace naris::particles {
 
 enum class Fate { outlet, inlet, wall, max_time, stagnated, lost };
 
-// The solver's open boundaries, "inlet" and "outlet"; every other patch is a no-slip wall.
-inline bool is_open_patch(const std::string& name) {
-  return name == "inlet" || name == "outlet";
-}
 inline constexpr int kFates = 6;
 const char* fate_name(Fate fate);
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "app/stage_settings.h"
+#include "core/hdf5_table.h"
 #include "solver/airflow/solution_file.h"
 
 namespace {
@@ -260,6 +262,7 @@ TEST_F(Cli, EveryStageOptionIsACaseFileKeyWithTheSameDefault) {
   check("mesh", naris::app::MeshSettings().table);
   check("solve", naris::app::SolveSettings().table);
   check("trace", naris::app::TraceSettings().table);
+  check("planes", naris::app::PlanesSettings().table);
 }
 
 TEST_F(Cli, UnknownOptionIsAnError) {
@@ -531,6 +534,9 @@ TEST_F(CliRunCase, BadCaseFilesAreClearErrors) {
   expect_clean_failure(
       naris("run " + write_case(out + "phantom: {}\n" + mesh + "trace: {count: 5}\n").string()),
       "the trace stage needs a solve section");
+  expect_clean_failure(
+      naris("run " + write_case(out + "phantom: {}\n" + mesh + "planes: {}\n").string()),
+      "the planes stage needs a solve section");
   expect_clean_failure(naris("run " + write_case(out + "phantom: {}\n" + mesh +
                                                  "solve: {}\ntrace: {release: rain}\n")
                                           .string()),
@@ -937,9 +943,182 @@ TEST_F(Cli, TraceBadInput) {
   expect_clean_failure(naris(trace + "--diameter 5,-1"), "diameter -1 µm: must not be negative");
   expect_clean_failure(naris(trace + "--diameter 5 --density -3"),
                        "density -3 kg/m³: must be positive");
-  expect_clean_failure(naris(trace + "--planes 500"), "plane 500 mm misses the airway");
+  expect_clean_failure(naris(trace + "--planes 500"), "plane at 500 mm: the airway runs");
   expect_clean_failure(naris(trace + "--plane \"p=0,0,-40;n=0,0,1\""), "misses the airway");
   expect_clean_failure(naris(trace + "--release grid --count 0"), "must be positive");
   expect_clean_failure(naris(trace + "--points " + points.string()),
                        "points needs release: points");
+}
+
+// Planes through the solved cut ball, with the crossings of a trace drawn on them: every file,
+// the flux through each plane equal to the inlet's, and the table the summary's.
+TEST_F(Cli, CutsPlanesThroughTheSolvedBall) {
+  const fs::path mesh = dir_ / "in" / "mesh.h5", flow = dir_ / "in" / "flow";
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
+  ASSERT_EQ(naris("solve " + mesh.string() + " --re 20 -o " + flow.string()).status, 0);
+  const fs::path solution = flow / "solution.h5", trace = dir_ / "trace", out = dir_ / "planes";
+  ASSERT_EQ(naris("trace " + solution.string() +
+                  " --release random --count 200 --planes 1.5,3 -o " + trace.string())
+                .status,
+            0);
+  const CliRun r = naris("planes " + solution.string() +
+                         " --at 1.5,3 --plane \"p=5.5,5.5,5.2;n=0,0.3,1\" --crossings " +
+                         (trace / "crossings.csv").string() + " -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f : {"planes.csv", "planes.vtp", "summary.json", "plane-1.png", "plane-1.svg",
+                        "plane-2.png", "plane-3.svg"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  std::ifstream csv(out / "planes.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("plane,label,distance_mm,piece,area_mm2,perimeter_mm,raw_perimeter_mm,", 0),
+            0u);
+  int planes = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string item; std::getline(ss, item, ',');) f.push_back(item);
+    if (f[3] != "all") continue;
+    ++planes;
+    // Flux / the inlet's: the ball is 8 voxels across, where the FE flow conserves mass to a
+    // few per cent (the accuracy is tested on the Poiseuille pipe and on the phantom).
+    EXPECT_NEAR(std::stod(f[9]), 1.0, 0.03) << line;
+    EXPECT_GT(std::stod(f[4]), 10.0) << line;
+  }
+  EXPECT_EQ(planes, 3);
+  EXPECT_GT(summary(out, "d_in_solution_mm"), 0.0);
+}
+
+TEST_F(Cli, PlanesBadInput) {
+  const fs::path mesh = dir_ / "in" / "mesh.h5", flow = dir_ / "in" / "flow";
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
+  ASSERT_EQ(naris("solve " + mesh.string() + " --re 5 -o " + flow.string()).status, 0);
+  const std::string planes =
+      "planes " + (flow / "solution.h5").string() + " -o " + (dir_ / "out").string() + " ";
+  const fs::path in = nrrd("ball2.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const fs::path other = dir_ / "in" / "other.h5";
+  ASSERT_EQ(naris("mesh " + in.string() + " --inlet k=2 --outlet k=8 -o " + other.string()).status,
+            0);
+  expect_clean_failure(naris(planes + "--mesh " + other.string()), "was not solved on");
+  expect_clean_failure(naris(planes + "--at 2,40"), "plane at 40 mm: the airway runs");
+  expect_clean_failure(naris(planes + "--at \"\" --plane \"p=0,0,-40;n=0,0,1\""),
+                       "misses the airway");
+  expect_clean_failure(naris(planes + "--at \"\""), "no planes");
+  expect_clean_failure(naris(planes + "--axis w"), "is not one of");
+  expect_clean_failure(naris(planes + "--smoothing 0"), "must be positive");
+  expect_clean_failure(naris(planes + "--levels 1"), "levels");
+  expect_clean_failure(naris(planes + "--at 2 --crossings " + (dir_ / "none.csv").string()),
+                       "cannot read the crossings");
+  expect_clean_failure(
+      naris("planes " + (dir_ / "absent.h5").string() + " -o " + (dir_ / "out").string()),
+      "absent.h5");
+}
+
+// Two subjects (the cut ball at two Reynolds numbers) compared: the table's numbers are the
+// summaries' own, and every file is written.
+TEST_F(Cli, ComparesSubjectsFromTheirSummaries) {
+  const fs::path mesh = dir_ / "in" / "mesh.h5";
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
+  for (const auto& [name, re] : {std::pair{"a", "20"}, std::pair{"b", "10"}}) {
+    const fs::path s = dir_ / name;
+    ASSERT_EQ(
+        naris("solve " + mesh.string() + " --re " + re + " -o " + (s / "solution").string()).status,
+        0);
+    const std::string solution = (s / "solution" / "solution.h5").string();
+    ASSERT_EQ(
+        naris("trace " + solution + " --release random --count 50 -o " + (s / "trace").string())
+            .status,
+        0);
+    ASSERT_EQ(naris("planes " + solution + " --at 1.5,3 -o " + (s / "planes").string()).status, 0);
+  }
+  const fs::path out = dir_ / "cmp";
+  const CliRun r = naris("compare " + (dir_ / "a").string() + " " + (dir_ / "b").string() +
+                         " --plane 2 -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f :
+       {"compare.csv", "compare.md", "plane-2.png", "plane-2.svg", "area-distance.png"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  std::ifstream csv(out / "compare.csv");
+  std::string line;
+  std::getline(csv, line);
+  std::vector<std::string> header;
+  {
+    std::stringstream ss(line);
+    for (std::string item; std::getline(ss, item, ',');) header.push_back(item);
+  }
+  auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return static_cast<std::size_t>(it - header.begin());
+  };
+  for (const char* name : {"a", "b"}) {
+    ASSERT_TRUE(std::getline(csv, line));
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string item; std::getline(ss, item, ',');) f.push_back(item);
+    ASSERT_EQ(f.size(), header.size()) << line;
+    EXPECT_EQ(f[0], name);
+    const fs::path s = dir_ / name;
+    EXPECT_DOUBLE_EQ(std::stod(f[column("flow_ml_s")]), summary(s / "solution", "flow_ml_s"));
+    EXPECT_DOUBLE_EQ(std::stod(f[column("pressure_drop_pa")]),
+                     summary(s / "solution", "pressure_drop_pa"));
+    EXPECT_DOUBLE_EQ(std::stod(f[column("d_in_mm")]),
+                     summary(s / "solution", "inlet_hydraulic_diameter_mm"));
+    EXPECT_DOUBLE_EQ(std::stod(f[column("max_speed_m_s")]),
+                     summary(s / "solution", "max_speed_m_s"));
+    std::ifstream planes(s / "planes" / "summary.json");
+    const auto p = nlohmann::json::parse(planes);
+    EXPECT_DOUBLE_EQ(std::stod(f[column("area_mm2_1.5 mm")]),
+                     p["planes"][0]["all"]["area_mm2"].get<double>());
+    EXPECT_DOUBLE_EQ(std::stod(f[column("max_speed_m_s_3 mm")]),
+                     p["planes"][1]["all"]["max_speed_m_s"].get<double>());
+    EXPECT_GT(std::stod(f[column("flux-weighted_outlet")]), 0.0);
+  }
+}
+
+TEST_F(Cli, CompareBadInput) {
+  const fs::path mesh = dir_ / "in" / "mesh.h5";
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
+  for (const auto& [name, at] : {std::pair{"a", "1.5,3"}, std::pair{"b", "2"}}) {
+    const fs::path s = dir_ / name;
+    ASSERT_EQ(naris("solve " + mesh.string() + " --re 5 -o " + (s / "solution").string()).status,
+              0);
+    ASSERT_EQ(naris("planes " + (s / "solution" / "solution.h5").string() + " --no-figures --at " +
+                    at + " -o " + (s / "planes").string())
+                  .status,
+              0);
+  }
+  ASSERT_EQ(
+      naris("solve " + mesh.string() + " --re 5 -o " + (dir_ / "c" / "solution").string()).status,
+      0);
+  const std::string compare = "compare -o " + (dir_ / "out").string() + " ";
+  const std::string a = (dir_ / "a").string(), b = (dir_ / "b").string(), c = (dir_ / "c").string();
+  expect_clean_failure(naris(compare + a + " " + b), "have different planes");
+  expect_clean_failure(naris(compare + a + " " + c), "no planes stage");
+  expect_clean_failure(naris(compare + a), "two subjects or more");
+  expect_clean_failure(naris(compare + a + " " + (dir_ / "in").string()), "neither a case folder");
+  expect_clean_failure(naris(compare + a + " " + a), "two subjects are named 'a'");
+  fs::copy(dir_ / "a", dir_ / "d", fs::copy_options::recursive);
+  // A subject whose mesh says metres.
+  const fs::path metres = dir_ / "m" / "mesh.h5";
+  fs::create_directories(metres.parent_path());
+  fs::copy(mesh, metres);
+  ASSERT_EQ(
+      naris("solve " + metres.string() + " --re 5 -o " + (dir_ / "m" / "solution").string()).status,
+      0);
+  ASSERT_EQ(naris("planes " + (dir_ / "m" / "solution" / "solution.h5").string() +
+                  " --no-figures --at 1.5,3 -o " + (dir_ / "m" / "planes").string())
+                .status,
+            0);
+  {
+    const hid_t file = H5Fopen(metres.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    ASSERT_GE(H5Adelete(file, "units"), 0);
+    naris::write_string_attribute(file, "units", "m", metres);
+    H5Fclose(file);
+  }
+  expect_clean_failure(naris(compare + a + " " + (dir_ / "m").string()),
+                       "a is in mm and m in m: compare subjects meshed in the same units");
+  expect_clean_failure(naris(compare + "--plane 9 " + a + " " + (dir_ / "d").string()),
+                       "plane 9: the subjects have planes 1 … 2");
 }

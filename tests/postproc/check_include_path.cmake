@@ -1,5 +1,6 @@
-# postproc builds without VTK, GDCM or PETSc on its include path: every compile command of a
-# postproc source (and of its tests) in compile_commands.json is checked.
+# The figures and the EOG models build without VTK, GDCM or PETSc on their include path: every
+# compile command of a postproc/figures or postproc/olfaction source (and of its tests) in
+# compile_commands.json is checked. postproc/planes cuts the solver's fields with VTK's filters.
 # Usage: cmake -DCOMMANDS=build/compile_commands.json -DSOURCE_DIR=<repo> -P check_include_path.cmake
 file(READ "${COMMANDS}" json)
 string(JSON count LENGTH "${json}")
@@ -7,7 +8,7 @@ math(EXPR last "${count} - 1")
 set(checked 0)
 foreach(i RANGE ${last})
   string(JSON source GET "${json}" ${i} file)
-  if(NOT source MATCHES "^${SOURCE_DIR}/(tests/)?postproc/")
+  if(NOT source MATCHES "^${SOURCE_DIR}/(tests/)?postproc/(figures|olfaction|test_olfaction)")
     continue()
   endif()
   string(JSON command GET "${json}" ${i} command)
@@ -20,6 +21,6 @@ foreach(i RANGE ${last})
   math(EXPR checked "${checked} + 1")
 endforeach()
 if(checked EQUAL 0)
-  message(FATAL_ERROR "no postproc source in ${COMMANDS}")
+  message(FATAL_ERROR "no figures or olfaction source in ${COMMANDS}")
 endif()
-message(STATUS "${checked} postproc sources compiled without VTK, GDCM or PETSc headers")
+message(STATUS "${checked} figures and olfaction sources compiled without VTK, GDCM or PETSc headers")

@@ -1,0 +1,70 @@
+#pragma once
+// Cross-sections of the flow solution (section 4.3.1, Table 4.3): the mesh cut by a plane with
+// VTK's cutter, its connected pieces, and per piece the area, the outline's length (raw and
+// smoothed at the voxel scale, outline.h), the hydraulic diameter 4A/P, the volume flux, the
+// mean and maximum axial velocity, the maximum speed and the flux through named regions.
+// Millimetres for geometry, SI for the flow.
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkUnstructuredGrid.h>
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "mesh/hybrid_mesh.h"
+#include "mesh/patches/section_planes.h"
+#include "postproc/planes/outline.h"
+
+namespace naris::planes {
+
+struct Measures {
+  double area = 0.0;                                   // mm²
+  double perimeter = 0.0, raw_perimeter = 0.0;         // mm: smoothed, and the outline as meshed
+  double hydraulic_diameter = 0.0;                     // mm: 4A/P on the smoothed perimeter
+  double raw_hydraulic_diameter = 0.0;                 // mm: 4A/P on the raw perimeter
+  double flux = 0.0;                                   // m³/s along the normal
+  double mean_axial = 0.0, max_axial = 0.0;            // m/s
+  double max_speed = 0.0;                              // m/s
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // mm
+  std::vector<double> region_flux;                     // m³/s through each region box's part
+};
+
+struct Section {
+  SectionPlane plane;
+  std::vector<Measures> pieces;  // largest area first
+  Measures whole;                // all pieces: sums and maxima (perimeters summed)
+  // Triangles (mm) with point arrays velocity, speed, axial_velocity, secondary_velocity (m/s)
+  // and cell array piece (1 = largest).
+  vtkSmartPointer<vtkPolyData> surface;
+  std::vector<Loop> outline;  // the wall's trace on the plane, as meshed
+};
+
+// The voxel spacing an MVE mesh was built on (the median hexahedron edge; without hexahedra,
+// the median edge of the tetrahedra), mm.
+double voxel_size(const HybridMesh& mesh);
+
+class SectionCutter {
+ public:
+  // `velocity`: nodal, m/s. `smoothing`: the Gaussian width for perimeters, mm.
+  SectionCutter(const HybridMesh& mesh, std::span<const Eigen::Vector3d> velocity,
+                double smoothing);
+  // Throws naris::Error when the plane does not cut the mesh.
+  Section cut(const SectionPlane& plane, const std::vector<RegionBox>& regions = {}) const;
+  // A boundary patch measured as a section (normal: its mean outward normal, reversed, so an
+  // inlet's inflow is positive).
+  Measures patch(int patch) const;
+
+ private:
+  const HybridMesh& mesh_;
+  std::span<const Eigen::Vector3d> velocity_;
+  double smoothing_;
+  vtkSmartPointer<vtkUnstructuredGrid> grid_;
+};
+
+// The speeds and velocities of a section's points as arrays on `surface` (in place).
+void add_flow_arrays(vtkPolyData* surface, const Eigen::Vector3d& normal);
+// Measures of one connected polygonal piece (triangles) with the arrays of add_flow_arrays.
+Measures measure_piece(vtkPolyData* piece, double smoothing, const std::vector<RegionBox>& regions);
+
+}  // namespace naris::planes
