@@ -268,20 +268,23 @@ void plan_flow_stages(const YAML::Node& root, const std::string& where, const fs
                            return planes::format_planes_summary(
                                *planes_job, planes::run_planes_job(*planes_job));
                          }});
-  // The report gathers the stages' tables and figures with the case file.
-  std::vector<fs::path> report_inputs{job->output / "summary.json",
+  // The report gathers the stages' tables and figures with the case file: any change to the
+  // case file reruns it.
+  std::vector<fs::path> report_inputs{plan.case_file, job->output / "summary.json",
                                       planes_job->output / "summary.json"};
-  if (!crossings.empty()) report_inputs.push_back(plan.out / "trace" / "summary.json");
+  const bool traced = !crossings.empty();
+  if (traced) report_inputs.push_back(plan.out / "trace" / "summary.json");
   plan.stages.push_back(
       {"report",
        report_inputs,
        {plan.out / "report.html"},
-       dump(root["planes"]),
-       [out = plan.out, name = plan.name, case_file = plan.case_file] {
+       dump(root),
+       [out = plan.out, name = plan.name, case_file = plan.case_file, traced] {
          std::ifstream in(case_file);
          std::stringstream text;
          text << in.rdbuf();
-         report::write_report(report::case_report(out, name, text.str(), NARIS_VERSION), out);
+         report::write_report(report::case_report(out, name, text.str(), NARIS_VERSION, traced),
+                              out);
          return fmt::format("naris report: {} and report.md", (out / "report.html").string());
        }});
 }

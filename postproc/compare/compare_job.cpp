@@ -62,6 +62,13 @@ Subject subject_of(const fs::path& input) {
          s.name, planes.string());
   s.solution = read_json_file(solution);
   s.planes = read_json_file(planes);
+  bool valid = s.planes.contains("planes") && s.planes["planes"].is_array() &&
+               s.planes.contains("axis_direction");
+  if (valid)
+    for (const Json& p : s.planes["planes"])
+      valid = valid && p.contains("label") && p.contains("point_mm") && p.contains("normal") &&
+              p.contains("all") && p["all"].contains("area_mm2");
+  if (!valid) fail("{}: not a summary of naris planes (rerun the planes stage)", planes.string());
   const fs::path trace = s.results / "trace" / "summary.json";
   if (fs::is_regular_file(trace)) s.trace = read_json_file(trace);
   const fs::path mesh = airflow::read_solution_h5(s.results / "solution" / "solution.h5").mesh_file;
@@ -88,8 +95,12 @@ Eigen::Vector3d vector_of(const Json& j) {
 // The table: one row per subject, numbers as in the summaries (six significant digits).
 void build_table(CompareResult& r) {
   const Subject& first = r.subjects.front();
+  // Column suffixes: a plane by distance by its label ("33.5 mm"), one by point and normal by
+  // its number (its label holds commas).
   std::vector<std::string> labels;
-  for (const Json& p : first.planes["planes"]) labels.push_back(p["label"].get<std::string>());
+  for (const Json& p : first.planes["planes"])
+    labels.push_back(p.contains("distance_mm") ? p["label"].get<std::string>()
+                                               : fmt::format("plane{}", labels.size() + 1));
   std::vector<std::string> regions;  // the flux shares the first subject's planes have
   if (!first.planes["planes"].empty() && first.planes["planes"][0]["all"].contains("flux_share"))
     for (const auto& [name, value] : first.planes["planes"][0]["all"]["flux_share"].items())
@@ -166,7 +177,8 @@ std::string markdown(const CompareResult& r) {
 CompareResult run_compare_job(const CompareJob& job) {
   const Stopwatch clock;
   if (job.inputs.size() < 2) fail("compare needs two subjects or more");
-  if (!(job.profile_step > 0.0)) fail("profile_step must be positive (mm)");
+  if (!(job.profile_step > 0.0 && job.profile_step <= 10.0))
+    fail("profile-step {} mm: give a spacing in (0, 10] mm", job.profile_step);
   CompareResult r;
   std::set<std::string> names;
   for (const fs::path& input : job.inputs) {
@@ -223,7 +235,10 @@ CompareResult run_compare_job(const CompareJob& job) {
       sections.push_back(cutter.cut(plane));
       u_in.push_back(solved.state.u_in);
       top = std::max(top, sections.back().whole.max_speed);
-      // Area against distance along the subject's own axis.
+      progress.update(i + 1);
+      // Area against distance along the subject's own axis (none for planes by point and
+      // normal alone).
+      if (!s.planes["axis_direction"].is_array()) continue;
       const Eigen::Vector3d axis = vector_of(s.planes["axis_direction"]);
       double tip = std::numeric_limits<double>::infinity(), end = -tip;
       for (const Eigen::Vector3d& x : solved.mesh.nodes)
@@ -242,11 +257,12 @@ CompareResult run_compare_job(const CompareJob& job) {
         series.y.push_back(area);
         if (std::isfinite(area) && !(area >= series.y[smallest])) smallest = series.x.size() - 1;
       }
+      if (series.x.size() < 2)
+        fail("{}: the airway is too short for a profile step of {} mm", s.name, job.profile_step);
       series.markers = {smallest};
       series.label = fmt::format("{} (min {:.0f} mm² at {:.0f} mm)", s.name, series.y[smallest],
                                  series.x[smallest]);
       profile.series.push_back(std::move(series));
-      progress.update(i + 1);
     }
     progress.finish();
     for (std::size_t i = 0; i < sections.size(); ++i) {
@@ -273,8 +289,10 @@ CompareResult run_compare_job(const CompareJob& job) {
         job.output / (stem + ".png"), job.output / (stem + ".svg"));
     r.files.push_back(stem + ".png");
     r.files.push_back(stem + ".svg");
-    figures::write_png(profile, job.output / "area-distance.png");
-    r.files.push_back("area-distance.png");
+    if (!profile.series.empty()) {
+      figures::write_png(profile, job.output / "area-distance.png");
+      r.files.push_back("area-distance.png");
+    }
   }
   report::Report rep;
   rep.title = fmt::format("naris comparison of {} subjects", r.subjects.size());

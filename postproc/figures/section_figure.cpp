@@ -183,7 +183,9 @@ void draw_legend(const Canvas& canvas, const SectionFigure& f, double max_speed,
   }
   cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
   canvas.text(bx, by0 - 22, "speed (m/s)", 14, 0.0, 0.5);
-  for (int k = 0; k <= f.levels; k += f.levels % 5 == 0 ? 3 : 1) {
+  // About five labels, the top (the maximum) always among them.
+  const int step = std::max(1, f.levels / 5);
+  for (int k = f.levels; k >= 0; k -= step) {
     const double y = by1 - (by1 - by0) * k / f.levels;
     canvas.text(bx + 34, y, fmt::format("{:.3g}", max_speed * k / f.levels), 13, 0.0, 0.5);
   }

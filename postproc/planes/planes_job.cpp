@@ -163,8 +163,11 @@ PlanesResult run_planes_job(const PlanesJob& job) {
   summary["reynolds"] = significant(r.reynolds);
   summary["inlet_speed_m_s"] = significant(r.u_in);
   summary["axis"] = job.distances_mm.empty() ? "" : job.axis;
-  summary["axis_direction"] = {significant(axis.direction[0]), significant(axis.direction[1]),
-                               significant(axis.direction[2])};
+  if (job.distances_mm.empty())
+    summary["axis_direction"] = nullptr;  // planes by point and normal only: no axis
+  else
+    summary["axis_direction"] = {significant(axis.direction[0]), significant(axis.direction[1]),
+                                 significant(axis.direction[2])};
   summary["voxel_mm"] = significant(r.voxel);
   summary["perimeter_smoothing_mm"] = significant(r.smoothing_mm);
   if (inlet >= 0) {
@@ -186,6 +189,9 @@ PlanesResult run_planes_job(const PlanesJob& job) {
     p["normal"] = {significant(s.plane.normal[0]), significant(s.plane.normal[1]),
                    significant(s.plane.normal[2])};
     p["pieces"] = s.pieces.size();
+    if (!drawn.empty())
+      p["crossings_drawn"] =
+          drawn[static_cast<std::size_t>(&s - r.sections.data())].crossings.size();
     p["all"] = measures_json(s.whole, r.u_in, inlet_flux, r.regions);
     Json pieces = Json::array();
     for (const Measures& m : s.pieces)

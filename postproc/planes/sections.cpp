@@ -140,6 +140,7 @@ Measures measure_piece(vtkPolyData* piece, double smoothing,
   integral->Update();
   vtkUnstructuredGrid* sums = integral->GetOutput();
   if (auto* a = sums->GetCellData()->GetArray("Area")) m.area = a->GetTuple1(0);
+  m.region_flux.assign(regions.size(), 0.0);
   if (!(m.area > 0.0)) return m;
   const double axial_sum = sums->GetPointData()->GetArray("axial_velocity")->GetTuple1(0);
   m.flux = axial_sum * kMm2;
@@ -168,7 +169,8 @@ Measures measure_piece(vtkPolyData* piece, double smoothing,
     clip->SetClipFunction(box);
     clip->InsideOutOn();
     clip->Update();
-    m.region_flux.push_back(integrate(clip->GetOutput(), "axial_velocity") * kMm2);
+    m.region_flux[static_cast<std::size_t>(&r - regions.data())] =
+        integrate(clip->GetOutput(), "axial_velocity") * kMm2;
   }
   return m;
 }
@@ -222,6 +224,8 @@ Section SectionCutter::cut(const SectionPlane& plane, const std::vector<RegionBo
   clean->PointMergingOn();
   clean->ToleranceIsAbsoluteOn();
   clean->SetAbsoluteTolerance(0.0);
+  clean->ConvertPolysToLinesOff();  // a plane through a pocket's tip leaves slivers as polygons
+  clean->ConvertLinesToPointsOff();
   clean->Update();
   vtkSmartPointer<vtkPolyData> surface = clean->GetOutput();
   if (surface->GetNumberOfCells() == 0) fail("plane {} does not cut the airway", plane.label);
@@ -248,11 +252,16 @@ Section SectionCutter::cut(const SectionPlane& plane, const std::vector<RegionBo
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
     return pieces[static_cast<std::size_t>(a)].area > pieces[static_cast<std::size_t>(b)].area;
   });
-  std::vector<int> rank(static_cast<std::size_t>(count));
+  // Pieces without area (a plane touching a pocket at a node or an edge) get piece 0 and no row.
+  std::vector<int> rank(static_cast<std::size_t>(count), 0);
   for (int k = 0; k < count; ++k) {
-    rank[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])] = k + 1;
-    s.pieces.push_back(pieces[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])]);
+    const Measures& m = pieces[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])];
+    if (!(m.area > 0.0)) continue;
+    s.pieces.push_back(m);
+    rank[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])] =
+        static_cast<int>(s.pieces.size());
   }
+  if (s.pieces.empty()) fail("plane {} touches the airway without cutting it", plane.label);
   // The piece of each cell, on the surface as written.
   vtkPolyData* colored = all->GetOutput();
   vtkDataArray* region = colored->GetPointData()->GetArray("RegionId");  // per point

@@ -35,7 +35,7 @@ struct Section {
   std::vector<Measures> pieces;  // largest area first
   Measures whole;                // all pieces: sums and maxima (perimeters summed)
   // Triangles (mm) with point arrays velocity, speed, axial_velocity, secondary_velocity (m/s)
-  // and cell array piece (1 = largest).
+  // and cell array piece (1 = largest; 0: slivers without area).
   vtkSmartPointer<vtkPolyData> surface;
   std::vector<Loop> outline;  // the wall's trace on the plane, as meshed
 };

@@ -125,7 +125,7 @@ void write_report(const Report& r, const fs::path& folder) {
 }
 
 Report case_report(const fs::path& results, const std::string& name, const std::string& settings,
-                   const std::string& version) {
+                   const std::string& version, bool traced) {
   Report r;
   r.title = fmt::format("naris report: {}", name);
   r.version = version;
@@ -175,7 +175,7 @@ Report case_report(const fs::path& results, const std::string& name, const std::
     r.sections.push_back(s);
   }
   const fs::path trace = results / "trace" / "summary.json";
-  if (fs::is_regular_file(trace)) {
+  if (traced && fs::is_regular_file(trace)) {
     const Json tr = read_json_file(trace);
     Section s{"Particle paths",
               fmt::format("{} particles, release: {}.", num(tr["particles"], 10),

@@ -29,8 +29,9 @@ struct Report {
 // report.md. Throws naris::Error when a figure cannot be read or a file written.
 void write_report(const Report& report, const std::filesystem::path& folder);
 
-// The report of a case's results folder (solution/, and trace/, planes/ where present).
+// The report of a case's results folder: solution/, planes/ where present, and trace/ when the
+// case traces (`traced`; a trace/ left by an earlier run is not the case's).
 Report case_report(const std::filesystem::path& results, const std::string& name,
-                   const std::string& settings, const std::string& version);
+                   const std::string& settings, const std::string& version, bool traced);
 
 }  // namespace naris::report

@@ -987,6 +987,7 @@ TEST_F(Cli, CutsPlanesThroughTheSolvedBall) {
   }
   EXPECT_EQ(planes, 3);
   EXPECT_GT(summary(out, "d_in_solution_mm"), 0.0);
+  EXPECT_GT(summary(out, "crossings_drawn"), 0.0);  // plane 1's share of the trace's crossings
 }
 
 TEST_F(Cli, PlanesBadInput) {
@@ -1096,6 +1097,7 @@ TEST_F(Cli, CompareBadInput) {
   expect_clean_failure(naris(compare + a + " " + b), "have different planes");
   expect_clean_failure(naris(compare + a + " " + c), "no planes stage");
   expect_clean_failure(naris(compare + a), "two subjects or more");
+  expect_clean_failure(naris(compare + "--profile-step 0 " + a + " " + b), "profile-step 0 mm");
   expect_clean_failure(naris(compare + a + " " + (dir_ / "in").string()), "neither a case folder");
   expect_clean_failure(naris(compare + a + " " + a), "two subjects are named 'a'");
   fs::copy(dir_ / "a", dir_ / "d", fs::copy_options::recursive);

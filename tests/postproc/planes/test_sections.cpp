@@ -3,6 +3,9 @@
 // pipe solved by naris (the flux of every plane equals the inlet's; the maximum axial velocity
 // is twice the mean).
 #include <gtest/gtest.h>
+#include <vtkCell.h>
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
 
 #include <cmath>
 #include <numbers>
@@ -72,7 +75,34 @@ TEST(Sections, TwoPiecesAreMeasuredApartLargestFirst) {
   EXPECT_NEAR(s.pieces[1].area / (pi * 0.09), 1.0, 0.03);
   EXPECT_NEAR(s.pieces[0].centroid[0], -0.8, 0.01);
   EXPECT_NEAR(s.pieces[1].centroid[0], 0.6, 0.01);
-  EXPECT_NEAR(s.whole.area, s.pieces[0].area + s.pieces[1].area, 1e-12);
+  // The surface's piece array names the same pieces: the area of its cells per piece.
+  double area[3] = {0.0, 0.0, 0.0};
+  vtkDataArray* piece = s.surface->GetCellData()->GetArray("piece");
+  ASSERT_NE(piece, nullptr);
+  for (vtkIdType c = 0; c < s.surface->GetNumberOfCells(); ++c) {
+    vtkCell* cell = s.surface->GetCell(c);
+    if (cell->GetNumberOfPoints() != 3) continue;
+    double a[3], b[3], d[3];
+    s.surface->GetPoint(cell->GetPointId(0), a);
+    s.surface->GetPoint(cell->GetPointId(1), b);
+    s.surface->GetPoint(cell->GetPointId(2), d);
+    const Vec3 ab = Vec3(b[0], b[1], b[2]) - Vec3(a[0], a[1], a[2]),
+               ad = Vec3(d[0], d[1], d[2]) - Vec3(a[0], a[1], a[2]);
+    area[static_cast<int>(piece->GetTuple1(c))] += 0.5 * ab.cross(ad).norm();
+  }
+  EXPECT_NEAR(area[1] / s.pieces[0].area, 1.0, 1e-12);
+  EXPECT_NEAR(area[2] / s.pieces[1].area, 1.0, 1e-12);
+}
+
+// A region box over half of a box's section takes exactly half of a uniform flux.
+TEST(Sections, ARegionBoxTakesItsShareOfTheFlux) {
+  const HybridMesh m = testing::box_hex(6);
+  const std::vector<Vec3> u = uniform(m, Vec3(0.0, 0.0, 2.0));
+  const RegionBox half{0, Vec3(-2, -2, -2), Vec3(0.0, 2, 2)}, none{0, Vec3(5, 5, 5), Vec3(6, 6, 6)};
+  const Section s = SectionCutter(m, u, 0.5).cut(plane({0, 0, 0.3141}, {0, 0, 1}), {half, none});
+  ASSERT_EQ(s.whole.region_flux.size(), 2u);
+  EXPECT_NEAR(s.whole.region_flux[0] / s.whole.flux, 0.5, 1e-12);
+  EXPECT_EQ(s.whole.region_flux[1], 0.0);
 }
 
 // A cylinder of R = 20 voxels sampled as a mask (1 inside, −1 outside, as a segmentation gives
@@ -156,7 +186,8 @@ TEST(Sections, PoiseuilleFlowKeepsItsFluxAndPeak) {
     ASSERT_EQ(s.pieces.size(), 1u);
     EXPECT_NEAR(s.whole.flux / inlet.flux, 1.0, 0.005) << "z = " << z;
     EXPECT_NEAR(s.whole.max_axial / s.whole.mean_axial, 2.0, 0.04) << "z = " << z;
-    EXPECT_EQ(s.whole.mean_axial, s.whole.flux / (s.whole.area * 1e-6));
+    EXPECT_EQ(s.whole.mean_axial, s.whole.flux / (s.whole.area * 1e-6));  // its definition
+    EXPECT_NEAR(s.whole.mean_axial / 0.5, 1.0, 0.01) << "z = " << z;      // the imposed mean
   }
 }
 
