@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 
 #include "core/atomic_file.h"
@@ -27,6 +28,7 @@ namespace naris::compare {
 namespace {
 
 namespace fs = std::filesystem;
+constexpr const char* kFates[] = {"outlet", "wall", "max-time", "stagnated"};
 
 // A case folder (case.yaml) or a results folder, to its name and results.
 Subject subject_of(const fs::path& input) {
@@ -71,9 +73,9 @@ Subject subject_of(const fs::path& input) {
   if (!valid) fail("{}: not a summary of naris planes (rerun the planes stage)", planes.string());
   const fs::path trace = s.results / "trace" / "summary.json";
   if (fs::is_regular_file(trace)) s.trace = read_json_file(trace);
-  const fs::path mesh = airflow::read_solution_h5(s.results / "solution" / "solution.h5").mesh_file;
-  if (mesh.empty()) fail("{}: its solution names no mesh file", s.name);
-  s.units = read_mesh_units(mesh);
+  s.solution_state = airflow::read_solution_h5(s.results / "solution" / "solution.h5");
+  if (s.solution_state.mesh_file.empty()) fail("{}: its solution names no mesh file", s.name);
+  s.units = read_mesh_units(s.solution_state.mesh_file);
   return s;
 }
 
@@ -110,7 +112,7 @@ void build_table(CompareResult& r) {
   for (const Subject& s : r.subjects)
     if (!s.trace.is_null())
       for (const Json& g : s.trace["per_group"])
-        for (const char* fate : {"outlet", "wall", "max-time", "stagnated"}) {
+        for (const char* fate : kFates) {
           const std::string key = fmt::format("{}_{}", g["group"].get<std::string>(), fate);
           if (group_fates.insert(key).second) traced.push_back(key);
         }
@@ -144,32 +146,26 @@ void build_table(CompareResult& r) {
         row.push_back(p["all"].contains("flux_share") && p["all"]["flux_share"].contains(region)
                           ? number(p["all"]["flux_share"][region])
                           : "");
-    for (const std::string& k : traced) {
-      std::string cell;
-      if (!s.trace.is_null())
-        for (const Json& g : s.trace["per_group"])
-          for (const char* fate : {"outlet", "wall", "max-time", "stagnated"})
-            if (fmt::format("{}_{}", g["group"].get<std::string>(), fate) == k)
-              cell = number(g[fate]);
-      row.push_back(cell);
-    }
+    std::map<std::string, std::string> fates;  // "<group>_<fate>" → count
+    if (!s.trace.is_null())
+      for (const Json& g : s.trace["per_group"])
+        for (const char* fate : kFates)
+          fates[fmt::format("{}_{}", g["group"].get<std::string>(), fate)] = number(g[fate]);
+    for (const std::string& k : traced) row.push_back(fates[k]);
     r.rows.push_back(std::move(row));
   }
 }
 
-std::string markdown(const CompareResult& r) {
-  // Transposed, one column per subject: the table stays readable with many planes.
-  std::string md = "| quantity |";
-  for (const Subject& s : r.subjects) md += fmt::format(" {} |", s.name);
-  md += "\n| --- |";
-  for (std::size_t i = 0; i < r.subjects.size(); ++i) md += " --- |";
-  md += "\n";
+// The table transposed, one column per subject: it stays readable with many planes.
+report::Table transposed(const CompareResult& r) {
+  report::Table t{{"quantity"}, {}};
+  for (const Subject& s : r.subjects) t.header.push_back(s.name);
   for (std::size_t c = 1; c < r.columns.size(); ++c) {
-    md += fmt::format("| {} |", r.columns[c]);
-    for (const auto& row : r.rows) md += fmt::format(" {} |", row[c]);
-    md += "\n";
+    std::vector<std::string> row{r.columns[c]};
+    for (const auto& subject_row : r.rows) row.push_back(subject_row[c]);
+    t.rows.push_back(std::move(row));
   }
-  return md;
+  return t;
 }
 
 }  // namespace
@@ -223,9 +219,9 @@ CompareResult run_compare_job(const CompareJob& job) {
     double top = 0.0;
     Progress progress("naris compare", r.subjects.size());
     for (std::size_t i = 0; i < r.subjects.size(); ++i) {
-      const Subject& s = r.subjects[i];
+      Subject& s = r.subjects[i];
       const airflow::SolvedMesh solved =
-          airflow::read_solved_mesh(s.results / "solution" / "solution.h5");
+          airflow::attach_mesh(std::move(s.solution_state), s.results / "solution" / "solution.h5");
       const double voxel = planes::voxel_size(solved.mesh);
       const planes::SectionCutter cutter(solved.mesh, solved.velocity, voxel);
       const Json& p = s.planes["planes"][static_cast<std::size_t>(job.plane - 1)];
@@ -272,10 +268,12 @@ CompareResult run_compare_job(const CompareJob& job) {
     }
   }
 
+  const report::Table by_quantity = transposed(r);
   table.write(job.output / "compare.csv");
   r.files.push_back("compare.csv");
   write_text_file(job.output / "compare.md",
-                  fmt::format("# Comparison of {} subjects\n\n{}", r.subjects.size(), markdown(r)));
+                  fmt::format("# Comparison of {} subjects\n\n{}", r.subjects.size(),
+                              report::markdown_table(by_quantity)));
   r.files.push_back("compare.md");
   if (job.figures) {
     const Json& p = first.planes["planes"][static_cast<std::size_t>(job.plane - 1)];
@@ -298,14 +296,7 @@ CompareResult run_compare_job(const CompareJob& job) {
   rep.title = fmt::format("naris comparison of {} subjects", r.subjects.size());
   rep.version = job.version;
   report::Section numbers{"Every subject's numbers", "From each subject's summary files.", {}, {}};
-  report::Table t{{"quantity"}, {}};
-  for (const Subject& s : r.subjects) t.header.push_back(s.name);
-  for (std::size_t c = 1; c < r.columns.size(); ++c) {
-    std::vector<std::string> row{r.columns[c]};
-    for (const auto& subject_row : r.rows) row.push_back(subject_row[c]);
-    t.rows.push_back(std::move(row));
-  }
-  numbers.tables.push_back(std::move(t));
+  numbers.tables.push_back(by_quantity);
   rep.sections.push_back(std::move(numbers));
   if (job.figures)
     rep.sections.push_back(

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/json.h"
+#include "solver/airflow/solution_file.h"
 
 namespace naris::compare {
 
@@ -26,8 +27,9 @@ struct CompareJob {
 struct Subject {
   std::string name;
   std::filesystem::path results;
-  Json solution, planes, trace;  // the stages' summary.json (trace: null when not traced)
-  std::string units;             // of its mesh
+  Json solution, planes, trace;           // the stages' summary.json (trace: null when not traced)
+  airflow::SolutionState solution_state;  // solution/solution.h5, read once
+  std::string units;                      // of its mesh
 };
 
 struct CompareResult {

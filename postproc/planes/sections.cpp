@@ -132,8 +132,8 @@ void add_flow_arrays(vtkPolyData* surface, const Eigen::Vector3d& normal) {
   surface->GetPointData()->SetActiveScalars("speed");
 }
 
-Measures measure_piece(vtkPolyData* piece, double smoothing,
-                       const std::vector<RegionBox>& regions) {
+Measures measure_piece(vtkPolyData* piece, double smoothing, const std::vector<RegionBox>& regions,
+                       std::vector<Loop>* outline) {
   Measures m;
   vtkNew<vtkIntegrateAttributes> integral;
   integral->SetInputData(piece);
@@ -155,9 +155,10 @@ Measures measure_piece(vtkPolyData* piece, double smoothing,
     m.max_speed = std::max(m.max_speed, speed->GetTuple1(i));
     m.max_axial = std::max(m.max_axial, axial->GetTuple1(i));
   }
-  for (const Loop& loop : outline_loops(piece)) {
+  for (Loop& loop : outline_loops(piece)) {
     m.raw_perimeter += loop_length(loop);
     m.perimeter += smoothed_loop_length(loop, smoothing);
+    if (outline) outline->push_back(std::move(loop));
   }
   m.hydraulic_diameter = m.perimeter > 0.0 ? 4.0 * m.area / m.perimeter : 0.0;
   m.raw_hydraulic_diameter = m.raw_perimeter > 0.0 ? 4.0 * m.area / m.raw_perimeter : 0.0;
@@ -244,8 +245,7 @@ Section SectionCutter::cut(const SectionPlane& plane, const std::vector<RegionBo
     one->SetExtractionModeToSpecifiedRegions();
     one->AddSpecifiedRegion(r);
     one->Update();
-    pieces.push_back(measure_piece(one->GetOutput(), smoothing_, regions));
-    for (const Loop& loop : outline_loops(one->GetOutput())) s.outline.push_back(loop);
+    pieces.push_back(measure_piece(one->GetOutput(), smoothing_, regions, &s.outline));
   }
   std::vector<int> order(static_cast<std::size_t>(count));
   std::iota(order.begin(), order.end(), 0);

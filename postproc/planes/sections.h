@@ -65,6 +65,8 @@ class SectionCutter {
 // The speeds and velocities of a section's points as arrays on `surface` (in place).
 void add_flow_arrays(vtkPolyData* surface, const Eigen::Vector3d& normal);
 // Measures of one connected polygonal piece (triangles) with the arrays of add_flow_arrays.
-Measures measure_piece(vtkPolyData* piece, double smoothing, const std::vector<RegionBox>& regions);
+// Its outline's loops are appended to `outline` when given.
+Measures measure_piece(vtkPolyData* piece, double smoothing, const std::vector<RegionBox>& regions,
+                       std::vector<Loop>* outline = nullptr);
 
 }  // namespace naris::planes

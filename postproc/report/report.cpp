@@ -60,7 +60,33 @@ std::string num(const Json& j, int digits = 4) {
   return j.is_number() ? fmt::format("{:.{}g}", j.get<double>(), digits) : "";
 }
 
+std::string html_table(const Table& t) {
+  std::string html = "<table><tr>";
+  for (const std::string& h : t.header) html += fmt::format("<th>{}</th>", escape(h));
+  html += "</tr>\n";
+  for (const auto& row : t.rows) {
+    html += "<tr>";
+    for (const std::string& c : row) html += fmt::format("<td>{}</td>", escape(c));
+    html += "</tr>\n";
+  }
+  return html + "</table>\n";
+}
+
 }  // namespace
+
+std::string markdown_table(const Table& t) {
+  std::string md = "|";
+  for (const std::string& h : t.header) md += fmt::format(" {} |", h);
+  md += "\n|";
+  for (std::size_t i = 0; i < t.header.size(); ++i) md += " --- |";
+  md += "\n";
+  for (const auto& row : t.rows) {
+    md += "|";
+    for (const std::string& c : row) md += fmt::format(" {} |", c);
+    md += "\n";
+  }
+  return md;
+}
 
 void write_report(const Report& r, const fs::path& folder) {
   std::string html = fmt::format(
@@ -81,27 +107,9 @@ void write_report(const Report& r, const fs::path& folder) {
       md += fmt::format("\n{}\n", s.text);
     }
     for (const Table& t : s.tables) {
-      html += "<table><tr>";
-      md += "\n|";
-      for (const std::string& h : t.header) {
-        html += fmt::format("<th>{}</th>", escape(h));
-        md += fmt::format(" {} |", h);
-      }
-      html += "</tr>\n";
-      md += "\n|";
-      for (std::size_t i = 0; i < t.header.size(); ++i) md += " --- |";
-      md += "\n";
-      for (const auto& row : t.rows) {
-        html += "<tr>";
-        md += "|";
-        for (const std::string& c : row) {
-          html += fmt::format("<td>{}</td>", escape(c));
-          md += fmt::format(" {} |", c);
-        }
-        html += "</tr>\n";
-        md += "\n";
-      }
-      html += "</table>\n";
+      html += html_table(t);
+      md += '\n';
+      md += markdown_table(t);
     }
     for (const fs::path& f : s.figures) {
       const std::string alt = f.stem().string();

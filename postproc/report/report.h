@@ -25,6 +25,9 @@ struct Report {
   std::string settings;  // the case file's text (or the comparison's inputs)
 };
 
+// A table as Markdown, header first.
+std::string markdown_table(const Table& table);
+
 // Writes report.html and report.md into `folder`; a figure path is written relative to it in
 // report.md. Throws naris::Error when a figure cannot be read or a file written.
 void write_report(const Report& report, const std::filesystem::path& folder);

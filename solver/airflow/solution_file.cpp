@@ -205,8 +205,13 @@ SolutionState read_solution_h5(const fs::path& path) {
 
 SolvedMesh read_solved_mesh(const std::filesystem::path& solution,
                             const std::filesystem::path& mesh_file) {
+  return attach_mesh(read_solution_h5(solution), solution, mesh_file);
+}
+
+SolvedMesh attach_mesh(SolutionState state, const std::filesystem::path& solution,
+                       const std::filesystem::path& mesh_file) {
   SolvedMesh r;
-  r.state = read_solution_h5(solution);
+  r.state = std::move(state);
   r.mesh_file = mesh_file.empty() ? r.state.mesh_file : mesh_file;
   if (r.mesh_file.empty())
     fail("{}: the solution names no mesh file; give the mesh", solution.string());

@@ -69,5 +69,8 @@ struct SolvedMesh {
 };
 SolvedMesh read_solved_mesh(const std::filesystem::path& solution,
                             const std::filesystem::path& mesh_file = {});
+// The same for a solution already read from `solution` (named in the errors).
+SolvedMesh attach_mesh(SolutionState state, const std::filesystem::path& solution,
+                       const std::filesystem::path& mesh_file = {});
 
 }  // namespace naris::airflow
