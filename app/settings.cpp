@@ -1,7 +1,9 @@
 #include "app/settings.h"
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 

@@ -3,15 +3,21 @@
 // (--name, dashes for underscores) and its section of a case file (name: value), with the same
 // names, defaults, help and checks. A boolean that defaults to true is switched off on the
 // command line by --no-name; one that defaults to false is switched on by --name.
-#include <yaml-cpp/yaml.h>
-
-#include <CLI/CLI.hpp>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <set>
 #include <string>
 #include <vector>
+
+// Forward declarations: CLI11 and yaml-cpp are heavy headers that most includers (the stages'
+// tables) never use.
+namespace CLI {
+class App;
+}
+namespace YAML {
+class Node;
+}
 
 namespace naris::app {
 

@@ -59,8 +59,9 @@ MeshSettings::MeshSettings() {
   table.add("inside", inside, "with a threshold: inside is 'below' or 'above' T")
       .one_of({"below", "above"});
   table.add("inlet", job.inlet,
-            "inlet cut plane: voxel index (e.g. j=19) or physical p=x,y,z;n=nx,ny,nz (mm); the "
-            "side towards the object's centre is kept");
+            "inlet cut plane: voxel index (e.g. j=19) or physical p=x,y,z;n=nx,ny,nz (mm); with "
+            "an outlet, the part between the two is kept, alone, the side towards the object's "
+            "centre");
   table.add("outlet", job.outlet, "outlet cut plane, same forms as inlet");
   table.add("patch", job.regions,
             "carve a named patch out of the wall: name:box=x0,y0,z0,x1,y1,z1 or "

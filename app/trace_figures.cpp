@@ -2,13 +2,13 @@
 
 #include <fmt/format.h>
 
+#include "core/units.h"
 #include "postproc/figures/particle_figures.h"
 
 namespace naris::app {
 namespace {
 
 using particles::Vec3;
-constexpr double kMm = 1e-3;
 
 figures::Point3 point3(const Vec3& x) {
   return {x[0], x[1], x[2]};

@@ -113,7 +113,24 @@ PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>&
   if (cuts.empty()) return prepared;
   const ImageFrame& frame = field.frame();
   prepared.centroid_index = inside_centroid(field);
-  for (const Cut& cut : cuts) {
+  // A point of a cut in voxel-index coordinates (an index plane's: the centroid moved onto it).
+  auto index_point = [&](const Cut& c) -> Eigen::Vector3d {
+    if (!c.plane.index_plane) return frame.continuous_index(c.plane.point);
+    Eigen::Vector3d x = prepared.centroid_index;
+    x[c.plane.axis] = c.plane.index;
+    return x;
+  };
+  for (std::size_t i = 0; i < cuts.size(); ++i) {
+    const Cut& cut = cuts[i];
+    // The side kept holds the other planes (between an inlet and an outlet), or the object's
+    // centroid when there is one plane.
+    Eigen::Vector3d keep = prepared.centroid_index;
+    if (cuts.size() > 1) {
+      keep.setZero();
+      for (std::size_t j = 0; j < cuts.size(); ++j)
+        if (j != i) keep += index_point(cuts[j]);
+      keep /= static_cast<double>(cuts.size() - 1);
+    }
     int axis = -1;
     double index = 0.0;
     if (cut.plane.index_plane) {
@@ -131,7 +148,12 @@ PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>&
       if (at < 0 || at >= frame.dims[axis])
         fail("{} plane '{}' lies outside the image (index {} of 0..{})", cut.patch, cut.plane.text,
              at, frame.dims[axis] - 1);
-      if (prepared.centroid_index[axis] >= at) {
+      if (cuts.size() > 1 && std::abs(keep[axis] - index) < 0.5)
+        fail(
+            "the {} plane '{}' lies in the voxel plane of the other cuts: nothing is between "
+            "them",
+            cut.patch, cut.plane.text);
+      if (keep[axis] >= at) {
         options.crop.lo[axis] = std::max(options.crop.lo[axis], at);
         options.side_patch[2 * axis] = cut.patch;
       } else {
@@ -141,10 +163,13 @@ PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>&
       }
       continue;
     }
-    // Oblique: keep the side of the plane that holds the object's centroid.
-    const Eigen::Vector3d c = frame.physical(prepared.centroid_index);
+    const Eigen::Vector3d c = frame.physical(keep);
     Eigen::Vector3d n = cut.plane.normal;
-    if (n.dot(c - cut.plane.point) < 0.0) n = -n;
+    const double side = n.dot(c - cut.plane.point);
+    if (cuts.size() > 1 && std::abs(side) < 0.5 * frame.spacing.minCoeff())
+      fail("the {} plane '{}' passes through the other cuts: it has no side between them",
+           cut.patch, cut.plane.text);
+    if (side < 0.0) n = -n;
     // n·(x − p) with x = origin + M·ijk, as a linear function of the voxel index.
     const Eigen::Matrix3d m = frame.index_to_physical();
     mve::ClipPlane clip;

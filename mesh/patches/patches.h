@@ -40,8 +40,9 @@ struct Cut {
 };
 
 // Prepares the mesher for the cuts: planes along an image axis become crop-box sides, oblique
-// planes become the mesher's clip planes; either way the side towards the object's centroid is
-// kept.
+// planes become the mesher's clip planes. Each keeps the side that holds the other planes (an
+// inlet and an outlet keep what lies between them); a single plane keeps the side towards the
+// object's centroid.
 struct PreparedCuts {
   std::vector<Cut> oblique;  // to be labelled after meshing
   Eigen::Vector3d centroid_index = Eigen::Vector3d::Zero();

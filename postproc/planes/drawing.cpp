@@ -16,13 +16,13 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/units.h"
 
 namespace naris::planes {
 namespace {
 
 namespace fs = std::filesystem;
 using Vec3 = Eigen::Vector3d;
-constexpr double kMlPerM3 = 1e6;
 
 // The figure's frame: v is "up" (+z, the patient's superior) within the plane, u = n × v, so
 // the plane is seen from the anterior (looking along the inlet → outlet axis).

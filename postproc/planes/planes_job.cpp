@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/json.h"
 #include "core/log.h"
+#include "core/units.h"
 #include "mesh/io/write_vtk.h"
 #include "postproc/figures/section_figure.h"
 #include "postproc/planes/drawing.h"
@@ -26,7 +27,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Vec3 = Eigen::Vector3d;
-constexpr double kMlPerM3 = 1e6;
 
 std::string number(double x) {
   return fmt::format("{:.8g}", x);

@@ -21,11 +21,10 @@
 #include <numeric>
 
 #include "core/error.h"
+#include "core/units.h"
 
 namespace naris::planes {
 namespace {
-
-constexpr double kMm2 = 1e-6;  // mm² → m²
 
 vtkSmartPointer<vtkDoubleArray> vector_array(const char* name, vtkIdType n) {
   auto a = vtkSmartPointer<vtkDoubleArray>::New();

@@ -5,12 +5,12 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/units.h"
 #include "solver/fem/reference_element.h"
 
 namespace naris::particles {
 namespace {
 
-constexpr double kMillimetre = 1e-3;
 // A walk that has not ended after this many cells runs along a face or an edge: it gives up,
 // and the tracker retries a shorter step.
 constexpr int kMaxWalk = 100000;
@@ -58,7 +58,7 @@ MeshFlow::MeshFlow(const HybridMesh& mesh, std::span<const Vec3> velocity,
   nodes_.resize(mesh.nodes.size());
   velocity_.resize(mesh.nodes.size());
   for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
-    nodes_[i] = mesh.nodes[i] * kMillimetre;
+    nodes_[i] = mesh.nodes[i] * kMm;
     velocity_[i] = velocity[i];
   }
   const std::size_t n = mesh.cell_count();
@@ -69,7 +69,7 @@ MeshFlow::MeshFlow(const HybridMesh& mesh, std::span<const Vec3> velocity,
   auto add = [&](std::span<const NodeId> ids, double volume_mm3) {
     std::copy(ids.begin(), ids.end(), &nodes_of_[8 * c]);
     count_[c] = static_cast<std::int8_t>(ids.size());
-    size_[c] = static_cast<float>(std::cbrt(std::abs(volume_mm3)) * kMillimetre);
+    size_[c] = static_cast<float>(std::cbrt(std::abs(volume_mm3)) * kMm);
     ++c;
   };
   for (const auto& t : mesh.tets)

@@ -9,11 +9,10 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/units.h"
 
 namespace naris::particles {
 namespace {
-
-constexpr double kMillimetre = 1e-3;
 
 double segment_distance(const Vec3& x, const Vec3& a, const Vec3& b) {
   const Vec3 d = b - a;
@@ -65,8 +64,8 @@ InletShape inlet_shape(const HybridMesh& mesh, int patch, const Vec3& up) {
   for_each_boundary_face(mesh, [&](std::span<const NodeId> ids, std::int32_t p) {
     if (p != patch) return;
     for (std::size_t k = 1; k + 1 < ids.size(); ++k)
-      s.triangles.push_back({mesh.nodes[ids[0]] * kMillimetre, mesh.nodes[ids[k]] * kMillimetre,
-                             mesh.nodes[ids[k + 1]] * kMillimetre});
+      s.triangles.push_back(
+          {mesh.nodes[ids[0]] * kMm, mesh.nodes[ids[k]] * kMm, mesh.nodes[ids[k + 1]] * kMm});
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const NodeId a = ids[k], b = ids[(k + 1) % ids.size()];
       ++edges[{std::min(a, b), std::max(a, b)}];
@@ -82,8 +81,7 @@ InletShape inlet_shape(const HybridMesh& mesh, int patch, const Vec3& up) {
   s.centre = first / s.area;
   s.normal = vector_area.normalized();
   for (const auto& [e, uses] : edges)
-    if (uses == 1)
-      s.outline.push_back({mesh.nodes[e.first] * kMillimetre, mesh.nodes[e.second] * kMillimetre});
+    if (uses == 1) s.outline.push_back({mesh.nodes[e.first] * kMm, mesh.nodes[e.second] * kMm});
   // Second moments of the area about the centre (vertices and centroid of each triangle).
   Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
   for (const auto& t : s.triangles) {
@@ -136,7 +134,7 @@ ReleaseSet dissertation_groups(const InletShape& inlet, double offset, int count
     fail(
         "the inlet is too small for release groups {:.3g} mm from its wall (its long axis spans "
         "{:.3g} mm)",
-        offset / kMillimetre, 2.0 * reach / kMillimetre);
+        offset / kMm, 2.0 * reach / kMm);
   ReleaseSet set;
   set.groups = {"ventral-tip", "midline", "dorsal-tip"};
   const double tip = (hi - lo) / 6.0;
@@ -169,7 +167,7 @@ ReleaseSet grid_release(const InletShape& inlet, int across, double offset) {
     }
   if (set.points.empty())
     fail("no point of a {}-point grid lies on the inlet {:.3g} mm from its wall", across,
-         offset / kMillimetre);
+         offset / kMm);
   return set;
 }
 
@@ -234,7 +232,7 @@ ReleaseSet flux_weighted_release(const HybridMesh& mesh, int patch, std::span<co
     if (uniform(rng) * top > here) continue;
     Vec3 x = Vec3::Zero();
     for (int c = 0; c < 3; ++c) x += w[c] * mesh.nodes[t.v[c]];
-    set.add(x * kMillimetre, 0);
+    set.add(x * kMm, 0);
   }
   return set;
 }
@@ -257,7 +255,7 @@ ReleaseSet read_release_points(const std::string& path) {
     }
     std::string group;
     if (!(fields >> group)) group = "points";
-    set.add(Vec3(x, y, z) * kMillimetre, group_id(set, group));
+    set.add(Vec3(x, y, z) * kMm, group_id(set, group));
   }
   if (set.points.empty()) fail("{}: no release points", path);
   return set;

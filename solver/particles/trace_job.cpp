@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/units.h"
 #include "mesh/io/mesh_h5.h"
 #include "mesh/patches/patches.h"
 #include "mesh/patches/section_planes.h"
@@ -21,7 +22,6 @@ namespace naris::particles {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kMm = 1e-3;
 
 Vec3 parse_vector(const std::string& text, const std::string& what) {
   std::string t = text;

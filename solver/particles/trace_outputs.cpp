@@ -16,13 +16,13 @@
 #include "core/csv.h"
 #include "core/error.h"
 #include "core/json.h"
+#include "core/units.h"
 #include "mesh/io/write_vtk.h"
 
 namespace naris::particles {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kMm = 1e-3;
 
 vtkSmartPointer<vtkIntArray> int_array(const char* name) {
   auto a = vtkSmartPointer<vtkIntArray>::New();

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <random>
 
+#include "core/units.h"
 #include "solver/nonlinear/navier_stokes_solver.h"
 #include "solver/ns/boundary_conditions.h"
 #include "solver/parallel/petsc.h"
@@ -23,8 +24,6 @@ namespace naris::particles {
 namespace {
 
 using std::numbers::pi;
-
-constexpr double kMm = 1e-3;
 
 // A pipe of radius 1 mm along z from 0 to `length` mm, `across` voxels across its diameter,
 // leaving the grid through its ends: patches inlet (z = 0), outlet, wall.
