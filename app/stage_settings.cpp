@@ -60,7 +60,7 @@ MeshSettings::MeshSettings() {
       .one_of({"below", "above"});
   table.add("inlet", job.inlet,
             "inlet cut plane: voxel index (e.g. j=19) or physical p=x,y,z;n=nx,ny,nz (mm); with "
-            "an outlet, the part between the two is kept, alone, the side towards the object's "
+            "an outlet, the part between the two is kept; alone, the side towards the object's "
             "centre");
   table.add("outlet", job.outlet, "outlet cut plane, same forms as inlet");
   table.add("patch", job.regions,

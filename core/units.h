@@ -1,5 +1,6 @@
 #pragma once
-// Sizes as the result files state them: "MB" is the mebibyte, 2²⁰ bytes, everywhere.
+// Units shared by the stages: lengths in mm and in SI, and "MB" as the result files state it (the
+// mebibyte, 2²⁰ bytes, everywhere).
 #include <cstddef>
 
 namespace naris {

@@ -113,24 +113,26 @@ PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>&
   if (cuts.empty()) return prepared;
   const ImageFrame& frame = field.frame();
   prepared.centroid_index = inside_centroid(field);
-  // A point of a cut in voxel-index coordinates (an index plane's: the centroid moved onto it).
-  auto index_point = [&](const Cut& c) -> Eigen::Vector3d {
-    if (!c.plane.index_plane) return frame.continuous_index(c.plane.point);
+  // Each cut keeps the side that holds the other cuts' points (an inlet and an outlet keep what
+  // lies between them), or the object's centroid when it is alone. An index plane's point is the
+  // centroid moved onto it.
+  const bool between = cuts.size() > 1;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> points;
+  for (const Cut& c : cuts) {
     Eigen::Vector3d x = prepared.centroid_index;
-    x[c.plane.axis] = c.plane.index;
-    return x;
-  };
+    if (c.plane.index_plane)
+      x[c.plane.axis] = c.plane.index;
+    else
+      x = frame.continuous_index(c.plane.point);
+    points.push_back(x);
+    sum += x;
+  }
   for (std::size_t i = 0; i < cuts.size(); ++i) {
     const Cut& cut = cuts[i];
-    // The side kept holds the other planes (between an inlet and an outlet), or the object's
-    // centroid when there is one plane.
-    Eigen::Vector3d keep = prepared.centroid_index;
-    if (cuts.size() > 1) {
-      keep.setZero();
-      for (std::size_t j = 0; j < cuts.size(); ++j)
-        if (j != i) keep += index_point(cuts[j]);
-      keep /= static_cast<double>(cuts.size() - 1);
-    }
+    const Eigen::Vector3d keep =
+        between ? Eigen::Vector3d((sum - points[i]) / static_cast<double>(cuts.size() - 1))
+                : prepared.centroid_index;
     int axis = -1;
     double index = 0.0;
     if (cut.plane.index_plane) {
@@ -148,7 +150,7 @@ PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>&
       if (at < 0 || at >= frame.dims[axis])
         fail("{} plane '{}' lies outside the image (index {} of 0..{})", cut.patch, cut.plane.text,
              at, frame.dims[axis] - 1);
-      if (cuts.size() > 1 && std::abs(keep[axis] - index) < 0.5)
+      if (between && std::abs(keep[axis] - index) < 0.5)
         fail(
             "the {} plane '{}' lies in the voxel plane of the other cuts: nothing is between "
             "them",
@@ -166,7 +168,7 @@ PreparedCuts prepare_cuts(const mve::FieldSource& field, const std::vector<Cut>&
     const Eigen::Vector3d c = frame.physical(keep);
     Eigen::Vector3d n = cut.plane.normal;
     const double side = n.dot(c - cut.plane.point);
-    if (cuts.size() > 1 && std::abs(side) < 0.5 * frame.spacing.minCoeff())
+    if (between && std::abs(side) < 0.5 * frame.spacing.minCoeff())
       fail("the {} plane '{}' passes through the other cuts: it has no side between them",
            cut.patch, cut.plane.text);
     if (side < 0.0) n = -n;

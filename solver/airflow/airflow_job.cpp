@@ -9,6 +9,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/units.h"
 #include "mesh/io/mesh_h5.h"
 #include "mesh/patches/patches.h"
 #include "mesh/quality/check.h"
@@ -74,7 +75,7 @@ AirflowMesh read_airflow_mesh(const AirflowJob& job, AirflowResult& r) {
       r.d_in_mm = p.hydraulic_diameter();
     }
   if (!(r.d_in_mm > 0.0)) fail("{}: the inlet patch has no area", job.mesh.string());
-  const double d_in = r.d_in_mm * 1e-3;
+  const double d_in = r.d_in_mm * kMm;
   r.u_in = job.inlet_speed ? *job.inlet_speed : job.reynolds * job.viscosity / d_in;
   r.reynolds = r.u_in * d_in / job.viscosity;
   // The inlet velocity (mean 1 in units of U_in) from the geometry in mm, where a user's

@@ -139,7 +139,7 @@ ns::WallStress flow_results(const AirflowJob& job, const Partition& part, const 
     stress.shear = gather_face_shear(stress.shear, part.piece.face_index, part.boundary_faces,
                                      PETSC_COMM_WORLD, 0);
   }
-  const double d_in = r.d_in_mm * 1e-3, force_scale = pscale * d_in * d_in;
+  const double d_in = r.d_in_mm * kMm, force_scale = pscale * d_in * d_in;
   for (const auto& p : stress.patches)
     r.patches.push_back({p.name, p.area * r.d_in_mm * r.d_in_mm, p.pressure * force_scale,
                          p.viscous * force_scale, p.mean_shear * pscale, p.max_shear * pscale});
