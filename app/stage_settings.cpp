@@ -79,6 +79,8 @@ MeshSettings::MeshSettings() {
   table.add("all_components", all_components,
             "keep every connected component (default: the largest only)");
   table.add("check", job.check, "the conformity/watertightness check");
+  table.add("threads", job.threads, "threads for the quality report and the check (0: every core)")
+      .non_negative();
   table.add("msh", job.write_msh, "the Gmsh file");
 }
 

@@ -43,19 +43,18 @@ double pyramid_volume(const HybridMesh& m, const std::array<NodeId, 5>& p) {
 }
 
 double hex_volume(const HybridMesh& m, const std::array<NodeId, 8>& h) {
-  // Divergence theorem over the six (possibly warped) faces, each split from its centroid.
+  // Divergence theorem over the six (possibly warped) faces, each split from its centroid c
+  // into four triangles: their c·(a × b) terms sum to c·((x₂ − x₀) × (x₃ − x₁)). Coordinates
+  // relative to node 0, which a closed surface allows, keep the products small.
+  std::array<Eigen::Vector3d, 8> x;
+  for (int n = 0; n < 8; ++n) x[n] = m.nodes[h[n]] - m.nodes[h[0]];
   double v = 0.0;
   for (const auto& f : kHexFaces) {
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (int n : f.v) c += m.nodes[h[n]];
-    c /= 4.0;
-    for (int e = 0; e < 4; ++e) {
-      const auto& a = m.nodes[h[f.v[e]]];
-      const auto& b = m.nodes[h[f.v[(e + 1) % 4]]];
-      v += c.dot(a.cross(b)) / 6.0;
-    }
+    const auto& q = f.v;
+    const Eigen::Vector3d c = 0.25 * (x[q[0]] + x[q[1]] + x[q[2]] + x[q[3]]);
+    v += c.dot((x[q[2]] - x[q[0]]).cross(x[q[3]] - x[q[1]]));
   }
-  return v;
+  return v / 6.0;
 }
 
 double mesh_volume(const HybridMesh& m) {

@@ -57,6 +57,30 @@ inline std::span<const CellFace> cell_faces(int nodes) {
   return kHexFaces;
 }
 
+// The edges of each cell type as local node pairs (VTK order).
+inline constexpr std::array<std::array<int, 2>, 6> kTetEdges = {
+    {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}}};
+inline constexpr std::array<std::array<int, 2>, 8> kPyramidEdges = {
+    {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 4}, {1, 4}, {2, 4}, {3, 4}}};
+inline constexpr std::array<std::array<int, 2>, 12> kHexEdges = {{{0, 1},
+                                                                  {1, 2},
+                                                                  {2, 3},
+                                                                  {3, 0},
+                                                                  {4, 5},
+                                                                  {5, 6},
+                                                                  {6, 7},
+                                                                  {7, 4},
+                                                                  {0, 4},
+                                                                  {1, 5},
+                                                                  {2, 6},
+                                                                  {3, 7}}};
+// The edges of a cell with 4, 5 or 8 nodes.
+inline std::span<const std::array<int, 2>> cell_edges(int nodes) {
+  if (nodes == 4) return kTetEdges;
+  if (nodes == 5) return kPyramidEdges;
+  return kHexEdges;
+}
+
 // Calls f(nodes, patch) for every boundary face, triangles then quadrilaterals; `nodes` is a
 // std::span over the face's node ids and `patch` its patch id (assignable).
 template <class F>

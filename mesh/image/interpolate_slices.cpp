@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "core/error.h"
+#include "core/parallel.h"
 
 namespace naris {
 namespace {
@@ -93,8 +94,7 @@ Volume<float> interpolate_slices(const Volume<float>& v, int axis, int k, SliceM
       }
     }
   };
-  const unsigned count = threads > 0 ? static_cast<unsigned>(threads)
-                                     : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned count = thread_count(threads);
   std::vector<std::thread> pool;
   for (unsigned t = 0; t < count; ++t) pool.emplace_back(worker);
   for (auto& t : pool) t.join();

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "core/error.h"
+#include "core/parallel.h"
 
 namespace naris {
 
@@ -270,7 +271,7 @@ Volume<float> render_phantom_ct(const NasalPhantom& phantom, const PhantomSampli
   ct.frame = phantom.frame(sampling.pixel, sampling.slice);
   const auto [ni, nj, nk] = ct.frame.dims;
   ct.values.assign(ct.frame.voxel_count(), 0.0f);
-  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = static_cast<int>(thread_count(threads));
   const int sub = sampling.subsamples, ss = sampling.slice_samples;
   const double pixel = sampling.pixel, slice = sampling.slice;
   auto render_slice = [&](int k) {

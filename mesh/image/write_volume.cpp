@@ -75,4 +75,8 @@ void write_ct_nrrd(const Volume<float>& ct, const std::filesystem::path& path) {
   write_nrrd(ct.frame, "int16", hu.data(), hu.size() * sizeof(std::int16_t), path);
 }
 
+void write_field_nrrd(const Volume<float>& field, const std::filesystem::path& path) {
+  write_nrrd(field.frame, "float", field.values.data(), field.values.size() * sizeof(float), path);
+}
+
 }  // namespace naris

@@ -14,4 +14,7 @@ void write_labelmap_nrrd(const Volume<std::uint8_t>& mask, const std::filesystem
 // A CT volume in Hounsfield units, rounded to int16 (clamped to its range) like a scanner's.
 void write_ct_nrrd(const Volume<float>& ct, const std::filesystem::path& path);
 
+// Any scalar field (a signed distance, a smoothed indicator) as float32, values unchanged.
+void write_field_nrrd(const Volume<float>& field, const std::filesystem::path& path);
+
 }  // namespace naris

@@ -25,18 +25,6 @@
 namespace naris {
 namespace {
 
-vtkSmartPointer<vtkPoints> make_points(const HybridMesh& mesh) {
-  auto coords = vtkSmartPointer<vtkDoubleArray>::New();
-  coords->SetNumberOfComponents(3);
-  coords->SetNumberOfTuples(static_cast<vtkIdType>(mesh.nodes.size()));
-  double* out = coords->GetPointer(0);
-  for (std::size_t n = 0; n < mesh.nodes.size(); ++n)
-    for (int a = 0; a < 3; ++a) out[3 * n + a] = mesh.nodes[n][a];
-  auto points = vtkSmartPointer<vtkPoints>::New();
-  points->SetData(coords);
-  return points;
-}
-
 // Builds a vtkCellArray from fixed-size cells without a per-cell call.
 template <class Cells>
 void append_cells(const Cells& cells, std::vector<vtkIdType>& offsets,
@@ -283,12 +271,31 @@ void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path,
 }
 
 namespace {
+// The boundary faces over the boundary's own nodes (in mesh order), not all the mesh's.
 vtkSmartPointer<vtkPolyData> boundary_polydata(const HybridMesh& mesh, bool triangulate) {
+  std::vector<NodeId> local(mesh.nodes.size(), -1);
+  for_each_boundary_face(mesh, [&](std::span<const NodeId> face, std::int32_t) {
+    for (NodeId n : face) local[n] = 0;
+  });
+  vtkIdType used = 0;
+  for (NodeId& l : local)
+    if (l == 0) l = static_cast<NodeId>(used++);
+  auto coords = vtkSmartPointer<vtkDoubleArray>::New();
+  coords->SetNumberOfComponents(3);
+  coords->SetNumberOfTuples(used);
+  double* xyz = coords->GetPointer(0);
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n)
+    if (local[n] >= 0)
+      for (int a = 0; a < 3; ++a)
+        xyz[3 * static_cast<std::size_t>(local[n]) + a] = mesh.nodes[n][a];
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetData(coords);
+
   std::vector<vtkIdType> offsets{0}, connectivity;
   auto patch = vtkSmartPointer<vtkIntArray>::New();
   patch->SetName("patch");
   for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f) {
-    for (NodeId n : mesh.boundary_tris[f]) connectivity.push_back(n);
+    for (NodeId n : mesh.boundary_tris[f]) connectivity.push_back(local[n]);
     offsets.push_back(static_cast<vtkIdType>(connectivity.size()));
     patch->InsertNextValue(mesh.boundary_tri_patch[f]);
   }
@@ -296,22 +303,23 @@ vtkSmartPointer<vtkPolyData> boundary_polydata(const HybridMesh& mesh, bool tria
     const auto& q = mesh.boundary_quads[f];
     if (triangulate) {
       for (const auto& tri : {std::array<NodeId, 3>{q[0], q[1], q[2]}, {q[0], q[2], q[3]}}) {
-        for (NodeId n : tri) connectivity.push_back(n);
+        for (NodeId n : tri) connectivity.push_back(local[n]);
         offsets.push_back(static_cast<vtkIdType>(connectivity.size()));
         patch->InsertNextValue(mesh.boundary_quad_patch[f]);
       }
     } else {
-      for (NodeId n : q) connectivity.push_back(n);
+      for (NodeId n : q) connectivity.push_back(local[n]);
       offsets.push_back(static_cast<vtkIdType>(connectivity.size()));
       patch->InsertNextValue(mesh.boundary_quad_patch[f]);
     }
   }
   auto poly = vtkSmartPointer<vtkPolyData>::New();
-  poly->SetPoints(make_points(mesh));
+  poly->SetPoints(points);
   poly->SetPolys(make_cell_array(offsets, connectivity));
   poly->GetCellData()->AddArray(patch);
   return poly;
 }
+
 }  // namespace
 
 void write_boundary_vtp(const HybridMesh& mesh, const std::filesystem::path& path,

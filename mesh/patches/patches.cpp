@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <cstdint>
 #include <regex>
 
 #include "core/error.h"
@@ -228,20 +228,31 @@ void finish_patches(HybridMesh& mesh, const mve::FieldSource& field, const std::
 
 std::vector<PatchReport> patch_report(const HybridMesh& mesh) {
   std::vector<PatchReport> report(mesh.patch_names.size());
-  std::vector<std::map<std::pair<NodeId, NodeId>, int>> edges(mesh.patch_names.size());
+  std::vector<std::vector<std::uint64_t>> edges(mesh.patch_names.size());  // (min, max) packed
   for (std::size_t p = 0; p < report.size(); ++p) report[p].name = mesh.patch_names[p];
   for_each_boundary_face(mesh, [&](std::span<const NodeId> face, std::int32_t patch) {
     report[patch].faces++;
     report[patch].area += polygon_area(mesh, face);
     for (std::size_t e = 0; e < face.size(); ++e) {
-      const NodeId a = face[e], b = face[(e + 1) % face.size()];
-      edges[patch][{std::min(a, b), std::max(a, b)}]++;
+      const auto a = static_cast<std::uint32_t>(face[e]),
+                 b = static_cast<std::uint32_t>(face[(e + 1) % face.size()]);
+      edges[patch].push_back(std::uint64_t{std::min(a, b)} << 32 | std::max(a, b));
     }
   });
   // A patch's perimeter: the edges that only one of its own faces uses.
-  for (std::size_t p = 0; p < report.size(); ++p)
-    for (const auto& [e, count] : edges[p])
-      if (count == 1) report[p].perimeter += (mesh.nodes[e.first] - mesh.nodes[e.second]).norm();
+  for (std::size_t p = 0; p < report.size(); ++p) {
+    auto& e = edges[p];
+    std::sort(e.begin(), e.end());
+    for (std::size_t i = 0; i < e.size();) {
+      std::size_t j = i;
+      while (j < e.size() && e[j] == e[i]) ++j;
+      if (j - i == 1)
+        report[p].perimeter += (mesh.nodes[static_cast<NodeId>(e[i] >> 32)] -
+                                mesh.nodes[static_cast<NodeId>(e[i] & 0xffffffffu)])
+                                   .norm();
+      i = j;
+    }
+  }
   return report;
 }
 

@@ -123,24 +123,33 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
   finish_patches(r.mesh, field, cuts, prepared, regions, options.wall_patch);
   r.seconds.push_back({"mve", clock.seconds()});
 
+  // The quality measured before and after improvement counts as one stage, improvement as another.
   clock = Stopwatch();
-  r.quality = cell_quality(r.mesh);
-  r.before = summarize_quality(r.mesh, r.quality);
+  r.quality = cell_quality(r.mesh, job.threads);
+  r.before = summarize_quality(r.mesh, r.quality, 20, job.threads);
+  double quality_seconds = clock.seconds();
   if (job.improve) {
+    clock = Stopwatch();
     r.improvement = improve_mesh(r.mesh, volume.frame.spacing.minCoeff(), job.improve_options);
-    r.quality = cell_quality(r.mesh);
+    r.seconds.push_back({"improve", clock.seconds()});
   }
+  clock = Stopwatch();
   if (job.subdivisions > 0) {
     r.cells_before_subdivision = r.mesh.cell_count();
     for (int level = 0; level < job.subdivisions; ++level) r.mesh = subdivide(r.mesh);
-    r.quality = cell_quality(r.mesh);
   }
-  r.after = summarize_quality(r.mesh, r.quality);
-  r.seconds.push_back({"quality", clock.seconds()});
+  if (job.improve || job.subdivisions > 0) {
+    r.quality = cell_quality(r.mesh, job.threads);
+    r.after = summarize_quality(r.mesh, r.quality, 20, job.threads);
+  } else {
+    r.after = r.before;
+  }
+  r.seconds.push_back({"quality", quality_seconds + clock.seconds()});
   r.patches = patch_report(r.mesh);
+  r.volume = mesh_volume(r.mesh);
   if (job.check) {
     clock = Stopwatch();
-    r.check = check_mesh(r.mesh);
+    r.check = check_mesh(r.mesh, job.threads);
     r.seconds.push_back({"check", clock.seconds()});
     if (!r.check->valid())
       fail(
@@ -202,7 +211,7 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
         {"hex", r.mesh.hexes.size()}}},
       {"boundary_faces",
        {{"tri", r.mesh.boundary_tris.size()}, {"quad", r.mesh.boundary_quads.size()}}},
-      {"volume_mm3", significant(mesh_volume(r.mesh))},
+      {"volume_mm3", significant(r.volume)},
       {"components", r.mve.components},
       {"dropped_components", r.mve.dropped_components},
       {"dropped_cells", r.mve.dropped_cells},
@@ -230,8 +239,8 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
       job.input.filename().string(), r.input.format,
       r.rule == InsideRule::label ? fmt::format("label {}", r.level)
                                   : fmt::format("inside {} {}", inside_rule_name(r.rule), r.level),
-      m.cell_count(), m.hexes.size(), m.pyramids.size(), m.tets.size(), m.nodes.size(),
-      mesh_volume(m), mesh_volume(m) / 1000.0);
+      m.cell_count(), m.hexes.size(), m.pyramids.size(), m.tets.size(), m.nodes.size(), r.volume,
+      r.volume / 1000.0);
   if (r.mve.dropped_components)
     s += fmt::format("  dropped   {} small component(s), {} cells (kept the largest)\n",
                      r.mve.dropped_components, r.mve.dropped_cells);

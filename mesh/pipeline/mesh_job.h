@@ -30,7 +30,8 @@ struct MeshJob {
   // Uniform refinements after the improvement (refine/subdivide.h): each multiplies the cells
   // by 8 and keeps the geometry, for mesh-convergence studies on one anatomy.
   int subdivisions = 0;
-  bool check = true;  // verify conformity and watertightness (costs a sort of all faces)
+  bool check = true;  // verify conformity and watertightness
+  int threads = 0;    // for quality and check (0: every core)
   std::filesystem::path output = "mesh.h5";
   bool write_vtu = true, write_stl = true, write_msh = true;
 };
@@ -46,6 +47,7 @@ struct MeshJobResult {
   QualityReport before, after;
   std::vector<CellQuality> quality;  // per cell of the final mesh, in its cell order
   std::vector<PatchReport> patches;
+  double volume = 0.0;  // mm³, of the final mesh
   std::optional<MeshCheck> check;
   std::vector<std::pair<std::string, double>> seconds;  // stage → wall time
   std::vector<std::string> written;

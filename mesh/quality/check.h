@@ -34,6 +34,8 @@ struct MeshCheck {
   std::string describe() const;
 };
 
-MeshCheck check_mesh(const HybridMesh& mesh);
+// Faces and edges are filed under their smallest node and matched node by node (linear time),
+// over `threads` threads (0: every core).
+MeshCheck check_mesh(const HybridMesh& mesh, int threads = 0);
 
 }  // namespace naris

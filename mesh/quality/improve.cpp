@@ -159,19 +159,13 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
 
   // Candidates: short edges of tetrahedra and pyramids, shortest first.
   std::vector<std::tuple<double, NodeId, NodeId>> edges;
-  static constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-  static constexpr int kPyrEdges[8][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0},
-                                          {0, 4}, {1, 4}, {2, 4}, {3, 4}};
   for (const auto& c : cells) {
     if (c.size == 8) continue;
     auto consider = [&](NodeId a, NodeId b) {
       const double len = (x[a] - x[b]).norm();
       if (len < min_edge) edges.emplace_back(len, std::min(a, b), std::max(a, b));
     };
-    if (c.size == 4)
-      for (const auto& e : kTetEdges) consider(c.v[e[0]], c.v[e[1]]);
-    else
-      for (const auto& e : kPyrEdges) consider(c.v[e[0]], c.v[e[1]]);
+    for (const auto& e : cell_edges(c.size)) consider(c.v[e[0]], c.v[e[1]]);
   }
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());

@@ -1,9 +1,13 @@
 #include "mesh/quality/quality.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <span>
+
+#include "core/parallel.h"
 
 namespace naris {
 namespace {
@@ -11,21 +15,39 @@ namespace {
 using Vec = Eigen::Vector3d;
 constexpr double kDeg = 180.0 / std::numbers::pi;
 
-// Cell shapes in VTK order: outward faces (the shared tables), and for each corner three
-// neighbours that form a right-handed frame in a valid cell.
+// Cell shapes in VTK order: outward faces (the shared tables), the pairs of faces that meet at
+// an edge, and for each corner three neighbours that form a right-handed frame in a valid cell.
 struct Shape {
   std::span<const CellFace> faces;
+  std::vector<std::array<int, 2>> adjacent_faces;
   std::vector<std::array<int, 4>> corners;  // vertex, then its three neighbours
   double jacobian_scale;                    // makes the ideal cell's corners 1
 };
 
+std::vector<std::array<int, 2>> adjacent_faces(std::span<const CellFace> faces) {
+  auto has = [](const CellFace& f, int node) {
+    return std::find(f.v.begin(), f.v.begin() + f.size, node) != f.v.begin() + f.size;
+  };
+  std::vector<std::array<int, 2>> pairs;
+  for (int f = 0; f < static_cast<int>(faces.size()); ++f)
+    for (int g = f + 1; g < static_cast<int>(faces.size()); ++g) {
+      int shared = 0;
+      for (int k = 0; k < faces[f].size; ++k) shared += has(faces[g], faces[f].v[k]);
+      if (shared == 2) pairs.push_back({f, g});
+    }
+  return pairs;
+}
+
 const Shape kTet{kTetFaces,
+                 adjacent_faces(kTetFaces),
                  {{{0, 1, 2, 3}}, {{1, 2, 0, 3}}, {{2, 0, 1, 3}}, {{3, 0, 2, 1}}},
                  std::numbers::sqrt2};
 const Shape kPyramid{kPyramidFaces,
+                     adjacent_faces(kPyramidFaces),
                      {{{0, 1, 3, 4}}, {{1, 2, 0, 4}}, {{2, 3, 1, 4}}, {{3, 0, 2, 4}}},
                      std::numbers::sqrt2};
 const Shape kHex{kHexFaces,
+                 adjacent_faces(kHexFaces),
                  {{{0, 1, 3, 4}},
                   {{1, 2, 0, 5}},
                   {{2, 3, 1, 6}},
@@ -42,47 +64,90 @@ Vec face_normal(const CellFace& f, std::span<const Vec> x) {
   return (x[v[2]] - x[v[0]]).cross(x[v[3]] - x[v[1]]);
 }
 
-bool has(const CellFace& f, int node) {
-  return std::find(f.v.begin(), f.v.begin() + f.size, node) != f.v.begin() + f.size;
+double degrees(double cosine) {
+  return std::acos(std::clamp(cosine, -1.0, 1.0)) * kDeg;
 }
 
+// A hexahedron that is an axis-aligned box, right-handed (the interior cells of MVE): its
+// metrics are exact without angles. Returns false for any other hexahedron.
+bool measure_box(std::span<const Vec> x, CellQuality& q) {
+  const Vec a = x[1] - x[0], b = x[3] - x[0], c = x[4] - x[0];
+  const double h[3] = {a.norm(), b.norm(), c.norm()};
+  const double tol = 1e-12 * std::max({h[0], h[1], h[2]});
+  auto axis = [&](const Vec& e, int d) {
+    return e[d] > 0.0 && std::abs(e[(d + 1) % 3]) <= tol && std::abs(e[(d + 2) % 3]) <= tol;
+  };
+  // The three edges from corner 0 along three distinct axes, in a right-handed order.
+  int da = -1, db = -1, dc = -1;
+  for (int d = 0; d < 3; ++d) {
+    if (axis(a, d)) da = d;
+    if (axis(b, d)) db = d;
+    if (axis(c, d)) dc = d;
+  }
+  if (da < 0 || db < 0 || dc < 0 || db != (da + 1) % 3 || dc != (da + 2) % 3) return false;
+  const Vec corners[8] = {x[0],     x[0] + a,     x[0] + a + b,     x[0] + b,
+                          x[0] + c, x[0] + a + c, x[0] + a + b + c, x[0] + b + c};
+  for (int k = 0; k < 8; ++k)
+    if ((x[k] - corners[k]).lpNorm<Eigen::Infinity>() > tol) return false;
+  q.edge_ratio = static_cast<float>(std::max({h[0], h[1], h[2]}) / std::min({h[0], h[1], h[2]}));
+  q.equiangle_skew = 0.0f;
+  q.min_dihedral = 90.0f;
+  q.scaled_jacobian = 1.0f;
+  return true;
+}
+
+// Angles are compared through their cosines (acos decreases), so each face takes two arc
+// cosines and the dihedral angles one.
 CellQuality measure(const Shape& s, std::span<const Vec> x) {
   CellQuality q{};
-  double shortest = INFINITY, longest = 0.0, skew = 0.0;
-  for (const auto& f : s.faces) {
+  if (x.size() == 8 && measure_box(x, q)) return q;
+  double shortest = INFINITY, longest = 0.0;
+  // The extreme corner cosines over the triangles [0] and over the quadrilaterals [1]: eq. 3.5's
+  // maximum over faces of one kind follows from them.
+  double cos_min[2] = {1.0, 1.0}, cos_max[2] = {-1.0, -1.0};
+  std::array<Vec, 6> unit_normal;
+  for (std::size_t fi = 0; fi < s.faces.size(); ++fi) {
+    const CellFace& f = s.faces[fi];
     const auto n = static_cast<std::size_t>(f.size);
-    const double eq = n == 3 ? 60.0 : 90.0;
-    double amax = 0.0, amin = 180.0;
+    std::array<Vec, 4> edge;
+    std::array<double, 4> length;
     for (std::size_t c = 0; c < n; ++c) {
-      const Vec a = x[f.v[(c + n - 1) % n]] - x[f.v[c]], b = x[f.v[(c + 1) % n]] - x[f.v[c]];
-      const double len = b.norm();
-      shortest = std::min(shortest, len);
-      longest = std::max(longest, len);
-      const double denom = a.norm() * len;
-      const double angle =
-          denom > 0.0 ? std::acos(std::clamp(a.dot(b) / denom, -1.0, 1.0)) * kDeg : 0.0;
-      amax = std::max(amax, angle);
-      amin = std::min(amin, angle);
+      edge[c] = x[f.v[(c + 1) % n]] - x[f.v[c]];
+      length[c] = edge[c].norm();
+      shortest = std::min(shortest, length[c]);
+      longest = std::max(longest, length[c]);
     }
-    skew = std::max({skew, (amax - eq) / (180.0 - eq), (eq - amin) / eq});
+    // The corner at node c lies between −edge[c−1] and edge[c]; a degenerate corner counts as 0°.
+    const int kind = n == 3 ? 0 : 1;
+    for (std::size_t c = 0; c < n; ++c) {
+      const std::size_t b = (c + n - 1) % n;
+      const double denom = length[b] * length[c];
+      const double cosine = denom > 0.0 ? -edge[b].dot(edge[c]) / denom : 1.0;
+      cos_min[kind] = std::min(cos_min[kind], cosine);
+      cos_max[kind] = std::max(cos_max[kind], cosine);
+    }
+    const Vec normal = face_normal(f, x);
+    const double norm = normal.norm();
+    unit_normal[fi] = norm > 0.0 ? Vec(normal / norm) : Vec::Zero();
   }
   q.edge_ratio = static_cast<float>(shortest > 0.0 ? longest / shortest : INFINITY);
+  double skew = 0.0;
+  for (int kind = 0; kind < 2; ++kind) {
+    if (cos_max[kind] < cos_min[kind]) continue;  // no face of this kind
+    const double eq = kind == 0 ? 60.0 : 90.0;
+    skew = std::max(
+        {skew, (degrees(cos_min[kind]) - eq) / (180.0 - eq), (eq - degrees(cos_max[kind])) / eq});
+  }
   q.equiangle_skew = static_cast<float>(skew);
 
-  // Dihedral angles: π minus the angle between the outward normals of two faces on an edge.
-  double min_dihedral = 180.0;
-  for (std::size_t f = 0; f < s.faces.size(); ++f)
-    for (std::size_t g = f + 1; g < s.faces.size(); ++g) {
-      int shared = 0;
-      for (int k = 0; k < s.faces[f].size; ++k) shared += has(s.faces[g], s.faces[f].v[k]);
-      if (shared != 2) continue;
-      const Vec n1 = face_normal(s.faces[f], x), n2 = face_normal(s.faces[g], x);
-      const double d = n1.norm() * n2.norm();
-      const double between =
-          d > 0.0 ? std::acos(std::clamp(n1.dot(n2) / d, -1.0, 1.0)) * kDeg : 180.0;
-      min_dihedral = std::min(min_dihedral, 180.0 - between);
-    }
-  q.min_dihedral = static_cast<float>(min_dihedral);
+  // Dihedral angles: π minus the angle between the outward normals of two faces on an edge; a
+  // degenerate face makes it 0°.
+  double cos_between = 1.0;
+  for (const auto& [f, g] : s.adjacent_faces) {
+    const bool degenerate = unit_normal[f].isZero(0.0) || unit_normal[g].isZero(0.0);
+    cos_between = std::min(cos_between, degenerate ? -1.0 : unit_normal[f].dot(unit_normal[g]));
+  }
+  q.min_dihedral = static_cast<float>(180.0 - degrees(cos_between));
 
   double jac = INFINITY;
   for (const auto& c : s.corners) {
@@ -94,11 +159,72 @@ CellQuality measure(const Shape& s, std::span<const Vec> x) {
   return q;
 }
 
-double percentile(std::vector<float>& v, double p) {
-  if (v.empty()) return 0.0;
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
+std::size_t rank(std::size_t n, double p) {
+  return std::min(n - 1, static_cast<std::size_t>(p * (n - 1) + 0.5));
+}
+
+// Floats as unsigned integers in the same order, and back.
+std::uint32_t ordered_bits(float x) {
+  const auto u = std::bit_cast<std::uint32_t>(x);
+  return u & 0x80000000u ? ~u : u | 0x80000000u;
+}
+float from_ordered_bits(std::uint32_t u) {
+  return std::bit_cast<float>(u & 0x80000000u ? u & 0x7fffffffu : ~u);
+}
+
+// The values of the given ranks (ascending) among value(0 .. n−1), exactly, by radix selection:
+// one counting pass over the high 16 bits of their ordered bits finds each rank's bucket, a
+// second over the low 16 bits of the values in those buckets finds the value. No copy, no
+// reordering, two passes whatever the number of ranks.
+template <std::size_t R, class Value>
+std::array<float, R> select_ranks(std::size_t n, const Value& value,
+                                  const std::array<std::size_t, R>& ranks) {
+  constexpr std::size_t kBins = 1u << 16;
+  std::vector<std::uint32_t> high(kBins, 0);
+  for (std::size_t i = 0; i < n; ++i) ++high[ordered_bits(value(i)) >> 16];
+  std::array<std::uint32_t, R> bucket;
+  std::array<std::size_t, R> within;
+  std::size_t below = 0, b = 0;
+  for (std::size_t r = 0; r < R; ++r) {
+    while (below + high[b] <= ranks[r]) below += high[b++];
+    bucket[r] = static_cast<std::uint32_t>(b);
+    within[r] = ranks[r] - below;
+  }
+  // One low-bit count per distinct bucket (the ranks are ascending, so equal buckets are adjacent).
+  std::array<std::size_t, R> table;
+  std::vector<std::uint32_t> distinct;
+  for (std::size_t r = 0; r < R; ++r) {
+    if (r == 0 || bucket[r] != bucket[r - 1]) distinct.push_back(bucket[r]);
+    table[r] = distinct.size() - 1;
+  }
+  std::vector<std::uint32_t> low(distinct.size() * kBins, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t key = ordered_bits(value(i));
+    for (std::size_t d = 0; d < distinct.size(); ++d)
+      if (key >> 16 == distinct[d]) ++low[d * kBins + (key & 0xffffu)];
+  }
+  std::array<float, R> out;
+  for (std::size_t r = 0; r < R; ++r) {
+    const std::uint32_t* count = low.data() + table[r] * kBins;
+    std::size_t seen = 0, l = 0;
+    while (seen + count[l] <= within[r]) seen += count[l++];
+    out[r] = from_ordered_bits(bucket[r] << 16 | static_cast<std::uint32_t>(l));
+  }
+  return out;
+}
+
+float CellQuality::*member(Metric m) {
+  switch (m) {
+    case Metric::edge_ratio:
+      return &CellQuality::edge_ratio;
+    case Metric::equiangle_skew:
+      return &CellQuality::equiangle_skew;
+    case Metric::min_dihedral:
+      return &CellQuality::min_dihedral;
+    case Metric::scaled_jacobian:
+      break;
+  }
+  return &CellQuality::scaled_jacobian;
 }
 
 }  // namespace
@@ -131,44 +257,39 @@ float CellQuality::get(Metric m) const {
   return 0.0f;
 }
 
-std::vector<CellQuality> cell_quality(const HybridMesh& mesh) {
-  std::vector<CellQuality> out;
-  out.reserve(mesh.cell_count());
-  auto run = [&](const auto& cells, const Shape& shape) {
-    std::array<Vec, 8> x;
-    for (const auto& c : cells) {
-      for (std::size_t n = 0; n < c.size(); ++n) x[n] = mesh.nodes[c[n]];
-      out.push_back(measure(shape, std::span<const Vec>(x.data(), c.size())));
-    }
-  };
-  run(mesh.tets, kTet);
-  run(mesh.pyramids, kPyramid);
-  run(mesh.hexes, kHex);
+std::vector<CellQuality> cell_quality(const HybridMesh& mesh, int threads) {
+  std::vector<CellQuality> out(mesh.cell_count());
+  run_threads(thread_count(threads), [&](unsigned t, unsigned count) {
+    auto run = [&](const auto& cells, const Shape& shape, std::size_t offset) {
+      std::array<Vec, 8> x;
+      for (auto [i, end] = share(cells.size(), t, count); i < end; ++i) {
+        const auto& c = cells[i];
+        for (std::size_t n = 0; n < c.size(); ++n) x[n] = mesh.nodes[c[n]];
+        out[offset + i] = measure(shape, std::span<const Vec>(x.data(), c.size()));
+      }
+    };
+    run(mesh.tets, kTet, 0);
+    run(mesh.pyramids, kPyramid, mesh.tets.size());
+    run(mesh.hexes, kHex, mesh.tets.size() + mesh.pyramids.size());
+  });
   return out;
 }
 
-QualityReport summarize_quality(const HybridMesh& mesh, const std::vector<CellQuality>& q,
-                                int bins) {
+QualityReport summarize_quality(const HybridMesh& mesh, const std::vector<CellQuality>& q, int bins,
+                                int threads) {
   QualityReport r;
   const std::size_t t = mesh.tets.size(), p = mesh.pyramids.size();
   const std::array<std::pair<std::size_t, std::size_t>, 4> ranges = {
       {{0, t}, {t, t + p}, {t + p, q.size()}, {0, q.size()}}};
-  for (std::size_t g = 0; g < 4; ++g) {
-    for (std::size_t m = 0; m < kMetrics.size(); ++m) {
-      std::vector<float> v;
-      v.reserve(ranges[g].second - ranges[g].first);
-      for (std::size_t c = ranges[g].first; c < ranges[g].second; ++c)
-        v.push_back(q[c].get(kMetrics[m]));
+  const std::size_t tasks = ranges.size() * kMetrics.size();
+  run_threads(thread_count(threads), [&](unsigned worker, unsigned count) {
+    for (std::size_t task = worker; task < tasks; task += count) {
+      const std::size_t g = task / kMetrics.size(), m = task % kMetrics.size();
+      const auto [first, last] = ranges[g];
+      const float CellQuality::*field = member(kMetrics[m]);
       MetricSummary& s = r.summary[g][m];
-      s.count = v.size();
-      if (v.empty()) continue;
-      s.min = *std::min_element(v.begin(), v.end());
-      s.max = *std::max_element(v.begin(), v.end());
-      s.p1 = percentile(v, 0.01);
-      s.p5 = percentile(v, 0.05);
-      s.p50 = percentile(v, 0.50);
-      s.p95 = percentile(v, 0.95);
-      s.p99 = percentile(v, 0.99);
+      s.count = last - first;
+      if (s.count == 0) continue;
       // Fixed ranges so histograms before and after improvement compare bin by bin.
       switch (kMetrics[m]) {
         case Metric::edge_ratio:
@@ -185,13 +306,20 @@ QualityReport summarize_quality(const HybridMesh& mesh, const std::vector<CellQu
           break;
       }
       s.histogram.assign(static_cast<std::size_t>(bins), 0);
-      for (float x : v) {
-        const double u = (x - s.lo) / (s.hi - s.lo);
+      for (std::size_t c = first; c < last; ++c) {
+        const double u = (q[c].*field - s.lo) / (s.hi - s.lo);
         const int b = std::clamp(static_cast<int>(u * bins), 0, bins - 1);
         ++s.histogram[static_cast<std::size_t>(b)];
       }
+      const std::size_t n = s.count;
+      const auto v = select_ranks(
+          n, [&](std::size_t i) { return q[first + i].*field; },
+          std::array<std::size_t, 7>{0, rank(n, 0.01), rank(n, 0.05), rank(n, 0.50), rank(n, 0.95),
+                                     rank(n, 0.99), n - 1});
+      s.min = v[0], s.p1 = v[1], s.p5 = v[2], s.p50 = v[3], s.p95 = v[4], s.p99 = v[5],
+      s.max = v[6];
     }
-  }
+  });
   return r;
 }
 

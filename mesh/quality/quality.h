@@ -23,8 +23,9 @@ struct CellQuality {
   float get(Metric m) const;
 };
 
-// In the mesh's cell order: tets, then pyramids, then hexes.
-std::vector<CellQuality> cell_quality(const HybridMesh& mesh);
+// In the mesh's cell order: tets, then pyramids, then hexes; over `threads` threads (0: every
+// core).
+std::vector<CellQuality> cell_quality(const HybridMesh& mesh, int threads = 0);
 
 struct MetricSummary {
   std::size_t count = 0;
@@ -39,6 +40,6 @@ struct QualityReport {
   std::array<std::array<MetricSummary, 4>, 4> summary;  // [group][metric]
 };
 QualityReport summarize_quality(const HybridMesh& mesh, const std::vector<CellQuality>& q,
-                                int bins = 20);
+                                int bins = 20, int threads = 0);
 
 }  // namespace naris

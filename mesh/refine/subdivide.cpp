@@ -10,24 +10,6 @@ namespace naris {
 
 namespace {
 
-// The edges of each cell type as local node pairs (VTK order).
-constexpr std::array<std::array<int, 2>, 6> kTetEdges = {
-    {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}}};
-constexpr std::array<std::array<int, 2>, 8> kPyramidEdges = {
-    {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 4}, {1, 4}, {2, 4}, {3, 4}}};
-constexpr std::array<std::array<int, 2>, 12> kHexEdges = {{{0, 1},
-                                                           {1, 2},
-                                                           {2, 3},
-                                                           {3, 0},
-                                                           {4, 5},
-                                                           {5, 6},
-                                                           {6, 7},
-                                                           {7, 4},
-                                                           {0, 4},
-                                                           {1, 5},
-                                                           {2, 6},
-                                                           {3, 7}}};
-
 std::uint64_t edge_key(NodeId a, NodeId b) {
   if (a > b) std::swap(a, b);
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/parallel.h"
 
 namespace naris::olfaction {
 namespace {
@@ -232,8 +233,7 @@ OrderSearchResult search_orders(const std::vector<double>& u_fit, const std::vec
       progress.update(++done);
     }
   };
-  const unsigned threads = o.threads > 0 ? static_cast<unsigned>(o.threads)
-                                         : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = thread_count(o.threads);
   std::vector<std::thread> pool;
   for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
   for (auto& t : pool) t.join();

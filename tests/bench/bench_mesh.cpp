@@ -5,7 +5,10 @@
 // vtkDiscreteFlyingEdges3D surface extraction on the same volume in the same run. File writing
 // is timed separately.
 //
-// Usage: bench_mesh [--max N] [--no-write] [--out DIR]
+// With --write-fields DIR it writes the inputs of scripts/bench mesh's end-to-end table instead:
+// the mortar 256×256×128 and a sphere 64³ (radius 0.4·64) as signed distances (voxels, float).
+//
+// Usage: bench_mesh [--max N] [--no-write] [--out DIR] | bench_mesh --write-fields DIR
 #include <fmt/format.h>
 #include <vtkDiscreteFlyingEdges3D.h>
 #include <vtkImageData.h>
@@ -22,6 +25,7 @@
 #include <string>
 
 #include "core/log.h"
+#include "mesh/image/write_volume.h"
 #include "mesh/io/mesh_h5.h"
 #include "mesh/io/write_vtk.h"
 #include "mesh/mve/mve.h"
@@ -37,6 +41,32 @@ void reset_peak_memory() {
   std::ofstream("/proc/self/clear_refs") << "5";
 }
 
+Volume<float> sample(const mve::FieldSource& source) {
+  Volume<float> v;
+  v.frame = source.frame();
+  v.values.resize(v.frame.voxel_count());
+  const std::size_t plane = static_cast<std::size_t>(v.frame.dims[0]) * v.frame.dims[1];
+  for (int k = 0; k < v.frame.dims[2]; ++k)
+    source.read_slice(k, std::span<float>(v.values.data() + plane * k, plane));
+  return v;
+}
+
+void write_fields(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  write_field_nrrd(sample(bench::MortarField(256, 256, 128)), dir / "mortar-sdf-256.nrrd");
+  const int n = 64;
+  Volume<float> sphere;
+  sphere.frame.dims = {n, n, n};
+  sphere.values.resize(sphere.frame.voxel_count());
+  const double c = 0.5 * (n - 1), radius = 0.4 * n;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        sphere.values[sphere.frame.index(i, j, k)] = static_cast<float>(
+            radius - std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c)));
+  write_field_nrrd(sphere, dir / "sphere-sdf-64.nrrd");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -50,6 +80,10 @@ int main(int argc, char** argv) {
       write = false;
     else if (!std::strcmp(argv[a], "--out") && a + 1 < argc)
       out = argv[++a];
+    else if (!std::strcmp(argv[a], "--write-fields") && a + 1 < argc) {
+      write_fields(argv[++a]);
+      return 0;
+    }
   }
   set_verbosity(Verbosity::quiet);
   // Both meshers on one core: VTK's filters would otherwise use every core through its SMP
@@ -75,16 +109,8 @@ int main(int argc, char** argv) {
   for (const auto& s : sizes) {
     if (s[0] > max_n) break;
     // The same 0/1 volume for both meshers.
-    const bench::MortarField sdf(s[0], s[1], s[2]);
-    Volume<float> labels;
-    labels.frame = sdf.frame();
-    labels.values.resize(labels.frame.voxel_count());
-    const std::size_t plane = static_cast<std::size_t>(s[0]) * s[1];
-    for (int k = 0; k < s[2]; ++k) {
-      sdf.read_slice(k, std::span<float>(labels.values.data() + plane * k, plane));
-      for (std::size_t n = 0; n < plane; ++n)
-        labels.values[plane * k + n] = labels.values[plane * k + n] > 0.0f ? 1.0f : 0.0f;
-    }
+    Volume<float> labels = sample(bench::MortarField(s[0], s[1], s[2]));
+    for (float& v : labels.values) v = v > 0.0f ? 1.0f : 0.0f;
     const mve::VolumeField field(labels, InsideRule::label, 1.0);
 
     reset_peak_memory();
