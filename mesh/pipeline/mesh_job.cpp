@@ -130,16 +130,21 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
   double quality_seconds = clock.seconds();
   if (job.improve) {
     clock = Stopwatch();
-    r.improvement = improve_mesh(r.mesh, volume.frame.spacing.minCoeff(), job.improve_options);
+    std::vector<std::int64_t> unchanged_from;
+    r.improvement =
+        improve_mesh(r.mesh, volume.frame.spacing.minCoeff(), job.improve_options, &unchanged_from);
     r.seconds.push_back({"improve", clock.seconds()});
+    clock = Stopwatch();
+    r.quality = cell_quality(r.mesh, r.quality, unchanged_from, job.threads);
+    quality_seconds += clock.seconds();
   }
   clock = Stopwatch();
   if (job.subdivisions > 0) {
     r.cells_before_subdivision = r.mesh.cell_count();
     for (int level = 0; level < job.subdivisions; ++level) r.mesh = subdivide(r.mesh);
+    r.quality = cell_quality(r.mesh, job.threads);
   }
   if (job.improve || job.subdivisions > 0) {
-    r.quality = cell_quality(r.mesh, job.threads);
     r.after = summarize_quality(r.mesh, r.quality, 20, job.threads);
   } else {
     r.after = r.before;

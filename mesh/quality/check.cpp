@@ -60,6 +60,8 @@ void visit_uses(const HybridMesh& m, NodeId lo, NodeId hi, Visitor& v) {
   auto in = [&](NodeId n) { return n >= lo && n < hi; };
   auto cells = [&](const auto& list) {
     for (const auto& c : list) {
+      const auto [low, high] = std::minmax_element(c.begin(), c.end());
+      if (*low >= hi || *high < lo) continue;  // nothing of this cell is filed in the range
       for (NodeId n : c)
         if (in(n)) v.used(n);
       for (const auto& f : cell_faces(static_cast<int>(c.size()))) {

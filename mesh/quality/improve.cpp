@@ -121,7 +121,8 @@ Face collapsed(const Face& f, NodeId a, NodeId b) {
 
 }  // namespace
 
-ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOptions& options) {
+ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOptions& options,
+                          std::vector<std::int64_t>* unchanged_from) {
   Stopwatch clock;
   ImproveStats stats;
   const double min_edge = options.min_edge_fraction * voxel_size;
@@ -172,6 +173,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
   stats.short_edges = edges.size();
   if (edges.empty()) return stats;
 
+  std::vector<char> changed(cells.size(), 0);  // in shape or position
   Incidence node_cells, node_faces;
   node_cells.build(n_nodes, cells);
   node_faces.build(n_nodes, faces);
@@ -410,7 +412,9 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     }
 
     // Apply.
+    for (auto c : around_a) changed[c] = 1;
     for (auto c : around_b) {
+      changed[c] = 1;
       const Cell before = cells[c];
       cells[c] = collapsed(before, a, b);
       if (!cells[c].size)
@@ -433,6 +437,15 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
   mesh.tets.clear();
   mesh.pyramids.clear();
   mesh.hexes.clear();
+  // Cells keep their type order (tets, pyramids, hexes) and, within a type, their order; a
+  // pyramid turned tetrahedron joins the tetrahedra.
+  if (unchanged_from) {
+    unchanged_from->clear();
+    for (int size : {4, 5, 8})
+      for (std::size_t c = 0; c < cells.size(); ++c)
+        if (cells[c].size == size)
+          unchanged_from->push_back(changed[c] ? -1 : static_cast<std::int64_t>(c));
+  }
   for (const auto& c : cells) {
     if (c.size == 4)
       mesh.tets.push_back({c.v[0], c.v[1], c.v[2], c.v[3]});

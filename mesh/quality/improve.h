@@ -5,6 +5,8 @@
 // edge is never collapsed. Hexahedra and their nodes are never touched. A collapse is made only
 // if it keeps the mesh a conforming, watertight manifold and every changed cell positive.
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "mesh/hybrid_mesh.h"
 
@@ -27,6 +29,9 @@ struct ImproveStats {
   double seconds = 0.0;
 };
 
-ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOptions& options);
+// With unchanged_from: for each cell of the improved mesh (in its order), the index of the same
+// cell, in the same place, in the input mesh (its cell order), or −1 for a changed cell.
+ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOptions& options,
+                          std::vector<std::int64_t>* unchanged_from = nullptr);
 
 }  // namespace naris

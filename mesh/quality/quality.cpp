@@ -7,6 +7,7 @@
 #include <numbers>
 #include <span>
 
+#include "core/error.h"
 #include "core/parallel.h"
 
 namespace naris {
@@ -257,12 +258,17 @@ float CellQuality::get(Metric m) const {
   return 0.0f;
 }
 
-std::vector<CellQuality> cell_quality(const HybridMesh& mesh, int threads) {
+namespace {
+
+// Each cell's quality: known(c, q) may supply it, else it is measured.
+template <class Known>
+std::vector<CellQuality> qualities(const HybridMesh& mesh, int threads, const Known& known) {
   std::vector<CellQuality> out(mesh.cell_count());
   run_threads(thread_count(threads), [&](unsigned t, unsigned count) {
     auto run = [&](const auto& cells, const Shape& shape, std::size_t offset) {
       std::array<Vec, 8> x;
       for (auto [i, end] = share(cells.size(), t, count); i < end; ++i) {
+        if (known(offset + i, out[offset + i])) continue;
         const auto& c = cells[i];
         for (std::size_t n = 0; n < c.size(); ++n) x[n] = mesh.nodes[c[n]];
         out[offset + i] = measure(shape, std::span<const Vec>(x.data(), c.size()));
@@ -273,6 +279,24 @@ std::vector<CellQuality> cell_quality(const HybridMesh& mesh, int threads) {
     run(mesh.hexes, kHex, mesh.tets.size() + mesh.pyramids.size());
   });
   return out;
+}
+
+}  // namespace
+
+std::vector<CellQuality> cell_quality(const HybridMesh& mesh, int threads) {
+  return qualities(mesh, threads, [](std::size_t, CellQuality&) { return false; });
+}
+
+std::vector<CellQuality> cell_quality(const HybridMesh& mesh,
+                                      const std::vector<CellQuality>& previous,
+                                      std::span<const std::int64_t> unchanged_from, int threads) {
+  if (unchanged_from.size() != mesh.cell_count())
+    fail("internal: {} cell origins for {} cells", unchanged_from.size(), mesh.cell_count());
+  return qualities(mesh, threads, [&](std::size_t c, CellQuality& q) {
+    if (unchanged_from[c] < 0) return false;
+    q = previous[static_cast<std::size_t>(unchanged_from[c])];
+    return true;
+  });
 }
 
 QualityReport summarize_quality(const HybridMesh& mesh, const std::vector<CellQuality>& q, int bins,

@@ -2,6 +2,8 @@
 // Element quality (dissertation 3.4 and eq. 3.5): edge ratio, equi-angle skew, minimum dihedral
 // angle and scaled Jacobian, per cell and summarized per cell type.
 #include <array>
+#include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,12 @@ struct CellQuality {
 // In the mesh's cell order: tets, then pyramids, then hexes; over `threads` threads (0: every
 // core).
 std::vector<CellQuality> cell_quality(const HybridMesh& mesh, int threads = 0);
+// The same for a mesh derived from one of known quality: a cell with unchanged_from[c] ≥ 0 is
+// that cell of the former mesh, unchanged (improve_mesh says which), and takes its quality.
+std::vector<CellQuality> cell_quality(const HybridMesh& mesh,
+                                      const std::vector<CellQuality>& previous,
+                                      std::span<const std::int64_t> unchanged_from,
+                                      int threads = 0);
 
 struct MetricSummary {
   std::size_t count = 0;
