@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <unordered_map>
 
 #include "core/log.h"
@@ -171,7 +172,13 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   stats.short_edges = edges.size();
-  if (edges.empty()) return stats;
+  if (edges.empty()) {
+    if (unchanged_from) {
+      unchanged_from->resize(mesh.cell_count());
+      std::iota(unchanged_from->begin(), unchanged_from->end(), std::int64_t{0});
+    }
+    return stats;
+  }
 
   std::vector<char> changed(cells.size(), 0);  // in shape or position
   Incidence node_cells, node_faces;

@@ -85,6 +85,20 @@ TEST(Improve, RandomFieldsStayConformingWatertightAndPositive) {
   }
 }
 
+TEST(Improve, WithNothingToCollapseEveryCellIsUnchanged) {
+  ArrayField f(8, 8, 8);
+  for (int k = 0; k < 8; ++k)
+    for (int j = 0; j < 8; ++j)
+      for (int i = 0; i < 8; ++i) f.at(i, j, k) = static_cast<float>(2.5 - std::abs(i - 3.5));
+  HybridMesh m = mve::march_volume_elements(f, testing::quiet_options());
+  std::vector<std::int64_t> unchanged_from;
+  const ImproveStats s = improve_mesh(m, 1.0, ImproveOptions{0.0, 0.02}, &unchanged_from);
+  EXPECT_EQ(s.collapsed, 0u);
+  ASSERT_EQ(unchanged_from.size(), m.cell_count());
+  for (std::size_t c = 0; c < unchanged_from.size(); ++c)
+    EXPECT_EQ(unchanged_from[c], static_cast<std::int64_t>(c));
+}
+
 TEST(Quality, IdealCellsScoreIdeal) {
   HybridMesh m;
   const double h = std::sqrt(0.5);
