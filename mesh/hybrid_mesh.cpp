@@ -120,4 +120,28 @@ void compact_nodes(HybridMesh& m) {
   apply(m.boundary_quads);
 }
 
+HybridMesh boundary_surface(const HybridMesh& mesh) {
+  HybridMesh s;
+  s.patch_names = mesh.patch_names;
+  std::vector<NodeId> local(mesh.nodes.size(), -1);
+  auto take = [&](const auto& faces, auto& out) {
+    for (auto f : faces) {
+      for (NodeId& v : f) {
+        auto& l = local[static_cast<std::size_t>(v)];
+        if (l < 0) {
+          l = static_cast<NodeId>(s.nodes.size());
+          s.nodes.push_back(mesh.nodes[static_cast<std::size_t>(v)]);
+        }
+        v = l;
+      }
+      out.push_back(f);
+    }
+  };
+  take(mesh.boundary_tris, s.boundary_tris);
+  take(mesh.boundary_quads, s.boundary_quads);
+  s.boundary_tri_patch = mesh.boundary_tri_patch;
+  s.boundary_quad_patch = mesh.boundary_quad_patch;
+  return s;
+}
+
 }  // namespace naris

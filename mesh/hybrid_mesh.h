@@ -120,4 +120,8 @@ void remove_empty_patches(HybridMesh& m);
 // Drops nodes that no cell uses and renumbers the rest, keeping their order.
 void compact_nodes(HybridMesh& m);
 
+// The boundary faces of `mesh` (same order, same patches) over their own nodes only, numbered
+// in order of first use; no cells. What boundary.vtp holds.
+HybridMesh boundary_surface(const HybridMesh& mesh);
+
 }  // namespace naris

@@ -271,23 +271,15 @@ void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path,
 }
 
 namespace {
-// The boundary faces over the boundary's own nodes (in mesh order), not all the mesh's.
-vtkSmartPointer<vtkPolyData> boundary_polydata(const HybridMesh& mesh, bool triangulate) {
-  std::vector<NodeId> local(mesh.nodes.size(), -1);
-  for_each_boundary_face(mesh, [&](std::span<const NodeId> face, std::int32_t) {
-    for (NodeId n : face) local[n] = 0;
-  });
-  vtkIdType used = 0;
-  for (NodeId& l : local)
-    if (l == 0) l = static_cast<NodeId>(used++);
+// The boundary faces over the boundary's own nodes, not all the mesh's.
+vtkSmartPointer<vtkPolyData> boundary_polydata(const HybridMesh& whole, bool triangulate) {
+  const HybridMesh mesh = boundary_surface(whole);
   auto coords = vtkSmartPointer<vtkDoubleArray>::New();
   coords->SetNumberOfComponents(3);
-  coords->SetNumberOfTuples(used);
+  coords->SetNumberOfTuples(static_cast<vtkIdType>(mesh.nodes.size()));
   double* xyz = coords->GetPointer(0);
   for (std::size_t n = 0; n < mesh.nodes.size(); ++n)
-    if (local[n] >= 0)
-      for (int a = 0; a < 3; ++a)
-        xyz[3 * static_cast<std::size_t>(local[n]) + a] = mesh.nodes[n][a];
+    for (int a = 0; a < 3; ++a) xyz[3 * n + a] = mesh.nodes[n][a];
   auto points = vtkSmartPointer<vtkPoints>::New();
   points->SetData(coords);
 
@@ -295,7 +287,7 @@ vtkSmartPointer<vtkPolyData> boundary_polydata(const HybridMesh& mesh, bool tria
   auto patch = vtkSmartPointer<vtkIntArray>::New();
   patch->SetName("patch");
   for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f) {
-    for (NodeId n : mesh.boundary_tris[f]) connectivity.push_back(local[n]);
+    for (NodeId n : mesh.boundary_tris[f]) connectivity.push_back(n);
     offsets.push_back(static_cast<vtkIdType>(connectivity.size()));
     patch->InsertNextValue(mesh.boundary_tri_patch[f]);
   }
@@ -303,12 +295,12 @@ vtkSmartPointer<vtkPolyData> boundary_polydata(const HybridMesh& mesh, bool tria
     const auto& q = mesh.boundary_quads[f];
     if (triangulate) {
       for (const auto& tri : {std::array<NodeId, 3>{q[0], q[1], q[2]}, {q[0], q[2], q[3]}}) {
-        for (NodeId n : tri) connectivity.push_back(local[n]);
+        for (NodeId n : tri) connectivity.push_back(n);
         offsets.push_back(static_cast<vtkIdType>(connectivity.size()));
         patch->InsertNextValue(mesh.boundary_quad_patch[f]);
       }
     } else {
-      for (NodeId n : q) connectivity.push_back(local[n]);
+      for (NodeId n : q) connectivity.push_back(n);
       offsets.push_back(static_cast<vtkIdType>(connectivity.size()));
       patch->InsertNextValue(mesh.boundary_quad_patch[f]);
     }

@@ -145,7 +145,7 @@ void fill_range(const HybridMesh& m, NodeRange& r) {
   visit_uses(m, r.lo, r.hi, fill);
 }
 
-// The counts of one node range, summed over all of them.
+// The counts of one thread's cells and node ranges, summed over the threads.
 struct Tally {
   MeshCheck check;
   long unique_cell_faces = 0, unique_cell_edges = 0, unique_boundary_edges = 0;
@@ -154,6 +154,8 @@ struct Tally {
   void add(const Tally& o) {
     MeshCheck& c = check;
     const MeshCheck& d = o.check;
+    c.nonpositive_cells += d.nonpositive_cells;
+    c.min_volume = std::min(c.min_volume, d.min_volume);
     c.unmatched_faces += d.unmatched_faces;
     c.misoriented_pairs += d.misoriented_pairs;
     c.overshared_faces += d.overshared_faces;
@@ -275,8 +277,6 @@ MeshCheck check_mesh(const HybridMesh& m, int threads) {
     }
     std::lock_guard guard(lock);
     total.add(mine);
-    total.check.nonpositive_cells += c.nonpositive_cells;
-    total.check.min_volume = std::min(total.check.min_volume, c.min_volume);
   });
 
   MeshCheck r = total.check;

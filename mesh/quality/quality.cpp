@@ -245,17 +245,7 @@ const char* metric_name(Metric m) {
 }
 
 float CellQuality::get(Metric m) const {
-  switch (m) {
-    case Metric::edge_ratio:
-      return edge_ratio;
-    case Metric::equiangle_skew:
-      return equiangle_skew;
-    case Metric::min_dihedral:
-      return min_dihedral;
-    case Metric::scaled_jacobian:
-      return scaled_jacobian;
-  }
-  return 0.0f;
+  return this->*member(m);
 }
 
 namespace {

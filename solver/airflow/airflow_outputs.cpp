@@ -43,32 +43,6 @@ void remove_stale_volume_files(const fs::path& vtu, const fs::path& pvtu, int ra
     fs::remove(pvtu_piece_path(pvtu, k), ignored);
 }
 
-// The boundary faces of `mesh` and their nodes only, in the same face order: boundary.vtp
-// without the interior points, and what the rank that writes it keeps of the whole mesh.
-HybridMesh boundary_surface(const HybridMesh& mesh) {
-  HybridMesh s;
-  s.patch_names = mesh.patch_names;
-  std::vector<NodeId> local(mesh.nodes.size(), -1);
-  auto take = [&](const auto& faces, auto& out) {
-    for (auto f : faces) {
-      for (NodeId& v : f) {
-        auto& l = local[static_cast<std::size_t>(v)];
-        if (l < 0) {
-          l = static_cast<NodeId>(s.nodes.size());
-          s.nodes.push_back(mesh.nodes[static_cast<std::size_t>(v)]);
-        }
-        v = l;
-      }
-      out.push_back(f);
-    }
-  };
-  take(mesh.boundary_tris, s.boundary_tris);
-  take(mesh.boundary_quads, s.boundary_quads);
-  s.boundary_tri_patch = mesh.boundary_tri_patch;
-  s.boundary_quad_patch = mesh.boundary_quad_patch;
-  return s;
-}
-
 // The per-patch forces of every rank's faces, summed (the maximum shear: the largest).
 void reduce_patch_forces(std::vector<PatchForce>& patches, MPI_Comm comm) {
   std::vector<double> sums, maxima;
@@ -211,7 +185,7 @@ void write_boundary(const AirflowJob& job, const Partition& part, const ns::Wall
   const fs::path vtp = job.output / "boundary.vtp";
   int ranks = 1;
   MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
-  write_boundary_vtp(ranks > 1 ? part.surface : boundary_surface(part.piece.mesh), vtp, faces);
+  write_boundary_vtp(ranks > 1 ? part.surface : part.piece.mesh, vtp, faces);
   written.push_back(vtp.string());
 }
 
