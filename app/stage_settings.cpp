@@ -44,12 +44,28 @@ SegmentSettings::SegmentSettings() {
             "rotate the volume first, AXIS:DEGREES about image axis i, j or k (e.g. i:30); "
             "seeds in voxels then refer to the rotated grid, seeds in mm do not change");
   table.add("decimate", job.decimate, "average N×N blocks of each slice first").range(1, 16);
+  table
+      .add("airway", job.airway,
+           "'any': the region grown from the seeds; 'nasal': the nasal airway of a head CT, "
+           "without seeds (room air cut at the nares, sinuses left out, inlet and outlet planes "
+           "written to OUTPUT.json for the mesher's 'auto')")
+      .one_of({"any", "nasal"});
+  table.add("side", side, "with airway nasal: the right or left cavity to its choana, or both")
+      .one_of({"right", "left", "both"});
+  table
+      .add("nasopharynx", nasopharynx,
+           "with airway nasal: 'cut' at the choana (both sides: just behind it) or 'keep' it")
+      .one_of({"cut", "keep"});
 }
 
 SegmentJob SegmentSettings::resolve() const {
   SegmentJob j = job;
   j.inside = parse_threshold_side(inside);
   j.keep_largest = !all_components;
+  j.side = parse_nasal_side(side);
+  j.keep_nasopharynx = nasopharynx == "keep";
+  if (j.airway != "nasal" && (table.given("side") || table.given("nasopharynx")))
+    fail("side and nasopharynx belong to airway nasal");
   return j;
 }
 
@@ -59,10 +75,10 @@ MeshSettings::MeshSettings() {
   table.add("inside", inside, "with a threshold: inside is 'below' or 'above' T")
       .one_of({"below", "above"});
   table.add("inlet", job.inlet,
-            "inlet cut plane: voxel index (e.g. j=19) or physical p=x,y,z;n=nx,ny,nz (mm); with "
-            "an outlet, the part between the two is kept; alone, the side towards the object's "
-            "centre");
-  table.add("outlet", job.outlet, "outlet cut plane, same forms as inlet");
+            "inlet cut plane: voxel index (e.g. j=19) or physical p=x,y,z;n=nx,ny,nz (mm), or "
+            "'auto' (the naris plane of segment --airway nasal); with an outlet, the part between "
+            "the two is kept; alone, the side towards the object's centre");
+  table.add("outlet", job.outlet, "outlet cut plane, same forms as inlet ('auto': the choana)");
   table.add("patch", job.regions,
             "carve a named patch out of the wall: name:box=x0,y0,z0,x1,y1,z1 or "
             "name:sphere=x,y,z,r (mm); repeatable");

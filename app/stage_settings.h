@@ -38,6 +38,7 @@ struct InterpolateSettings : StageSettings<InterpolateJob> {
 struct SegmentSettings : StageSettings<SegmentJob> {
   std::string inside = "below";
   bool all_components = !job.keep_largest;
+  std::string side = "right", nasopharynx = "cut";
   SegmentSettings();
   SegmentJob resolve() const;
 };

@@ -7,6 +7,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json.h"
 #include "core/log.h"
 #include "mesh/image/read_volume.h"
 #include "mesh/image/resample.h"
@@ -168,6 +169,48 @@ SegmentJobResult run_segment_job(const SegmentJob& job) {
   if (!(r.threshold > info.min_value && r.threshold < info.max_value))
     fail("{}: threshold {} is outside the data range [{}, {}]: it selects nothing or everything",
          job.input.string(), r.threshold, info.min_value, info.max_value);
+  if (job.airway == "nasal") {
+    if (labelmap) fail("{}: --airway nasal needs a CT in HU, not a labelmap", job.input.string());
+    if (!job.seeds.empty()) fail("--airway nasal finds the nares itself: give no seed");
+    if (inside != InsideRule::below) fail("--airway nasal: the airway is below the threshold");
+    NasalAirwayOptions options;
+    if (job.threshold != "auto") options.threshold = r.threshold;
+    options.side = job.side;
+    options.keep_nasopharynx = job.keep_nasopharynx;
+    NasalAirway nasal = segment_nasal_airway(ct, options);
+    r.threshold = nasal.threshold;
+    std::size_t voxels = 0;
+    for (auto v : nasal.mask.values) voxels += v;
+    r.components = {1, voxels, 0};
+    r.frame = nasal.mask.frame;
+    r.inside = inside;
+    write_labelmap_nrrd(nasal.mask, job.output);
+    Json sidecar{{"airway", "nasal"},
+                 {"side", nasal_side_name(job.side)},
+                 {"nasopharynx", job.keep_nasopharynx ? "keep" : "cut"},
+                 {"threshold_hu", significant(nasal.threshold, 5)},
+                 {"volume_ml", significant(nasal.volume_ml, 5)},
+                 {"sinus_ml", significant(nasal.sinus_ml, 5)},
+                 {"sinuses", nasal.sinuses},
+                 {"room_ml", significant(nasal.room_ml, 5)},
+                 {"masked_voxels", nasal.masked_voxels},
+                 {"inlet", nasal.inlet},
+                 {"outlet", nasal.outlet.empty() ? Json() : Json(nasal.outlet)},
+                 {"choana_slice", nasal.choana ? Json(*nasal.choana) : Json()},
+                 {"ap_axis", std::string(1, static_cast<char>('i' + nasal.ap_axis))}};
+    Json& nares = sidecar["nares"] = Json::array();
+    for (const Naris& n : nasal.nares)
+      nares.push_back({{"side", n.right ? "right" : "left"},
+                       {"opening_mm2", significant(n.area, 5)},
+                       {"centre_mm", {n.centre[0], n.centre[1], n.centre[2]}},
+                       {"normal", {n.normal[0], n.normal[1], n.normal[2]}}});
+    write_json_file(segmentation_sidecar(job.output), sidecar);
+    nasal.mask = {};
+    r.nasal = std::move(nasal);
+    r.seconds = clock.seconds();
+    return r;
+  }
+  if (job.airway != "any") fail("airway '{}' is neither 'any' nor 'nasal'", job.airway);
   std::vector<Voxel> seeds;
   for (const auto& s : job.seeds) seeds.push_back(parse_seed(s, ct.frame));
   Volume<std::uint8_t> mask = seeds.empty() ? threshold_mask(ct, r.threshold, inside)
@@ -190,8 +233,33 @@ SegmentJobResult run_segment_job(const SegmentJob& job) {
   return r;
 }
 
+fs::path segmentation_sidecar(const fs::path& labelmap) {
+  fs::path p = labelmap;
+  if (p.extension() == ".gz") p.replace_extension();
+  return p.replace_extension(".json");
+}
+
 std::string format_segment_summary(const SegmentJob& job, const SegmentJobResult& r) {
   const double voxel_ml = r.frame.spacing.prod() / 1000.0;
+  if (r.nasal) {
+    const NasalAirway& a = *r.nasal;
+    std::string nares;
+    for (const Naris& n : a.nares)
+      nares +=
+          fmt::format("\n  {} naris: opening {:.1f} mm² at {:.1f},{:.1f},{:.1f} mm",
+                      n.right ? "right" : "left", n.area, n.centre[0], n.centre[1], n.centre[2]);
+    return fmt::format(
+        "naris segment: {} ({}, {}), nasal airway, {} side(s), nasopharynx {}\n  threshold {:.1f} "
+        "HU ({})\n  airway {:.2f} mL; left out: {} sinus cavities ({:.1f} mL), room air {:.0f} "
+        "mL{}{}\n  inlet {}\n  outlet {}\n  time {:.2f} s\n  wrote {} and {}",
+        job.input.filename().string(), dims_text(r.frame), spacing_text(r.frame),
+        nasal_side_name(job.side), job.keep_nasopharynx ? "kept" : "cut", r.threshold,
+        job.threshold == "auto" ? "automatic" : "given", a.volume_ml, a.sinuses, a.sinus_ml,
+        a.room_ml,
+        a.masked_voxels ? fmt::format("; {} masked voxels taken for tissue", a.masked_voxels) : "",
+        nares, a.inlet, a.outlet.empty() ? "(none: give one to the mesher)" : a.outlet, r.seconds,
+        job.output.string(), segmentation_sidecar(job.output).string());
+  }
   return fmt::format(
       "naris segment: {} ({}, {}, {})\n  threshold {:.1f} HU ({}), inside {}\n  airway {} voxels, "
       "{:.3f} mL; {} component(s), {} voxels dropped\n  time {:.2f} s\n  wrote {}",

@@ -9,6 +9,7 @@
 
 #include "mesh/image/hsr.h"
 #include "mesh/image/interpolate_slices.h"
+#include "mesh/image/nasal_airway.h"
 #include "mesh/image/phantom.h"
 #include "mesh/image/segment.h"
 
@@ -58,6 +59,11 @@ struct SegmentJob {
   bool keep_largest = true;
   std::string rotate;  // AXIS:DEGREES, AXIS one of i, j, k
   int decimate = 1;
+  // "any": the region grown from the seeds; "nasal": the nasal airway of a head CT, found
+  // without seeds (nasal_airway.h), with its inlet and outlet planes in <output>.json.
+  std::string airway = "any";
+  NasalSide side = NasalSide::right;
+  bool keep_nasopharynx = false;
 };
 struct SegmentJobResult {
   std::string format;
@@ -66,8 +72,11 @@ struct SegmentJobResult {
   InsideRule inside = InsideRule::below;
   bool labelmap = false;
   ComponentSummary components;
+  std::optional<NasalAirway> nasal;  // with airway "nasal" (its mask moved out)
   double seconds = 0.0;
 };
+// The sidecar of a segmentation: <output without its extension>.json.
+std::filesystem::path segmentation_sidecar(const std::filesystem::path& labelmap);
 SegmentJobResult run_segment_job(const SegmentJob& job);
 std::string format_segment_summary(const SegmentJob& job, const SegmentJobResult& r);
 

@@ -11,6 +11,7 @@
 #include "core/json.h"
 #include "core/log.h"
 #include "core/units.h"
+#include "mesh/image/image_jobs.h"
 #include "mesh/io/mesh_h5.h"
 #include "mesh/io/write_gmsh.h"
 #include "mesh/io/write_vtk.h"
@@ -95,6 +96,20 @@ Json quality_json(const QualityReport& q) {
   return out;
 }
 
+// "auto": the plane the segmentation found (naris segment --airway nasal), from its sidecar.
+std::string cut_plane_text(const std::string& text, const std::string& name,
+                           const fs::path& input) {
+  if (text != "auto") return text;
+  const fs::path sidecar = segmentation_sidecar(input);
+  if (!fs::is_regular_file(sidecar))
+    fail("{} 'auto' takes the plane from {}, which is absent (segment with --airway nasal)", name,
+         sidecar.string());
+  const Json planes = read_json_file(sidecar);
+  if (!planes.contains(name) || !planes[name].is_string())
+    fail("{} has no {} plane: give one explicitly", sidecar.string(), name);
+  return planes[name].get<std::string>();
+}
+
 }  // namespace
 
 MeshJobResult run_mesh_job(const MeshJob& job) {
@@ -105,8 +120,8 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
     fail("subdivide is {}: give 0 to 3 levels (each multiplies the cells by 8)", job.subdivisions);
   ensure_writable_folder(job.output.parent_path());
   std::vector<Cut> cuts;
-  if (job.inlet) cuts.push_back({"inlet", parse_cut_plane(*job.inlet)});
-  if (job.outlet) cuts.push_back({"outlet", parse_cut_plane(*job.outlet)});
+  for (const auto& [name, text] : {std::pair{"inlet", job.inlet}, std::pair{"outlet", job.outlet}})
+    if (text) cuts.push_back({name, parse_cut_plane(cut_plane_text(*text, name, job.input))});
   std::vector<Region> regions;
   for (const auto& text : job.regions) regions.push_back(parse_region(text));
 

@@ -1124,3 +1124,47 @@ TEST_F(Cli, CompareBadInput) {
   expect_clean_failure(naris(compare + "--plane 9 " + a + " " + (dir_ / "d").string()),
                        "plane 9: the subjects have planes 1 … 2");
 }
+
+// One NasalSeg adult (Zhang et al. 2024, CC BY 4.0) from the CT to the mesh: the right cavity
+// found without seeds, meshed between its naris and its choana with the planes the
+// segmentation wrote; nothing but wall, inlet and outlet bounds it.
+TEST_F(Cli, NasalSegRightCavityFromTheCtToTheMesh) {
+  const fs::path ct = fs::path(NARIS_SHARED_DATA) / "nasalseg" / "P005_img.nrrd";
+  if (!fs::exists(ct)) GTEST_SKIP() << "shared data absent: " << ct;
+  const fs::path airway = dir_ / "airway.nrrd";
+  CliRun r = naris("segment " + ct.string() + " --airway nasal --side right -o " + airway.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_TRUE(fs::exists(dir_ / "airway.json"));
+  r = naris("mesh " + airway.string() + " --inlet auto --outlet auto -o " +
+            (dir_ / "mesh" / "mesh.h5").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("conforming, watertight"), std::string::npos) << r.err;
+  std::ifstream file(dir_ / "mesh" / "mesh.json");
+  const nlohmann::json mesh = nlohmann::json::parse(file);
+  std::map<std::string, nlohmann::json> patches;
+  for (const auto& p : mesh["patches"]) patches[p["name"].get<std::string>()] = p;
+  EXPECT_EQ(patches.size(), 3u) << mesh["patches"].dump();
+  ASSERT_TRUE(patches.count("inlet") && patches.count("outlet"));
+  // An adult naris: tens of mm², a hydraulic diameter of a few mm.
+  EXPECT_GT(patches["inlet"]["area_mm2"].get<double>(), 20.0);
+  EXPECT_LT(patches["inlet"]["area_mm2"].get<double>(), 200.0);
+  EXPECT_GT(patches["inlet"]["hydraulic_diameter_mm"].get<double>(), 1.5);
+  EXPECT_LT(patches["inlet"]["hydraulic_diameter_mm"].get<double>(), 12.0);
+  const double ml = mesh["volume_mm3"].get<double>() / 1000.0;
+  EXPECT_GT(ml, 8.0);
+  EXPECT_LT(ml, 20.0);
+}
+
+TEST_F(Cli, NasalAirwayRefusesSeedsLabelmapsAndStrayOptions) {
+  const fs::path labels = nrrd("ball.nrrd", "uint8", "12 12 12", payload(ball_labels()));
+  const std::string o = " -o " + (dir_ / "out" / "airway.nrrd").string();
+  expect_clean_failure(naris("segment " + labels.string() + " --airway nasal" + o), "labelmap");
+  std::vector<std::int16_t> ct(12 * 12 * 12, -1000);
+  for (std::size_t q = 0; q < ct.size(); q += 3) ct[q] = 40;
+  const fs::path scan = nrrd("ct.nrrd", "int16", "12 12 12", payload(ct));
+  expect_clean_failure(naris("segment " + scan.string() + " --airway nasal --seed 1,1,1" + o),
+                       "seed");
+  expect_clean_failure(naris("segment " + scan.string() + " --side left" + o), "airway nasal");
+  expect_clean_failure(naris("segment " + scan.string() + " --airway nasal --side up" + o), "side");
+  expect_clean_failure(naris("mesh " + labels.string() + " --inlet auto " + out()), "auto");
+}

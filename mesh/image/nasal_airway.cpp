@@ -1,0 +1,606 @@
+#include "mesh/image/nasal_airway.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <queue>
+
+#include "core/error.h"
+#include "mesh/image/distance_transform.h"
+#include "mesh/image/segment.h"
+
+namespace naris {
+namespace {
+
+constexpr double kLumenDepth = 1.5;  // mm
+
+using Mask = std::vector<std::uint8_t>;
+
+// Index arithmetic and 6-neighbourhoods on one grid.
+struct VoxelGrid {
+  std::array<int, 3> n;
+  std::array<std::size_t, 3> stride;
+  explicit VoxelGrid(const ImageFrame& f)
+      : n(f.dims),
+        stride{1, static_cast<std::size_t>(f.dims[0]),
+               static_cast<std::size_t>(f.dims[0]) * static_cast<std::size_t>(f.dims[1])} {}
+  std::size_t size() const { return stride[2] * static_cast<std::size_t>(n[2]); }
+  int coord(std::size_t q, int axis) const {
+    return static_cast<int>(q / stride[axis] % static_cast<std::size_t>(n[axis]));
+  }
+  template <class F>
+  void neighbours(std::size_t q, F&& f) const {
+    for (int a = 0; a < 3; ++a) {
+      const int c = coord(q, a);
+      if (c > 0) f(q - stride[a], a, -1);
+      if (c + 1 < n[a]) f(q + stride[a], a, +1);
+    }
+  }
+};
+
+// The 6-connected region of `inside` reached from the seeds.
+template <class Inside>
+Mask flood(const VoxelGrid& g, const std::vector<std::size_t>& seeds, Inside&& inside) {
+  Mask out(g.size(), 0);
+  std::vector<std::size_t> stack;
+  for (std::size_t s : seeds)
+    if (!out[s] && inside(s)) out[s] = 1, stack.push_back(s);
+  while (!stack.empty()) {
+    const std::size_t q = stack.back();
+    stack.pop_back();
+    g.neighbours(q, [&](std::size_t r, int, int) {
+      if (!out[r] && inside(r)) out[r] = 1, stack.push_back(r);
+    });
+  }
+  return out;
+}
+
+// The image axes closest to the patient's left (x), posterior (y) and superior (z) in LPS, with
+// the sign of each along its axis.
+struct PatientAxes {
+  std::array<int, 3> axis{0, 1, 2};
+  std::array<int, 3> sign{1, 1, 1};
+};
+PatientAxes patient_axes(const ImageFrame& f) {
+  PatientAxes p;
+  for (int d = 0; d < 3; ++d) {
+    int best = 0;
+    for (int a = 1; a < 3; ++a)
+      if (std::abs(f.direction(d, a)) > std::abs(f.direction(d, best))) best = a;
+    p.axis[d] = best;
+    p.sign[d] = f.direction(d, best) < 0 ? -1 : 1;
+  }
+  if (p.axis[0] == p.axis[1] || p.axis[1] == p.axis[2] || p.axis[0] == p.axis[2])
+    fail("the image is oblique to the patient's axes by about 45°: resample it first");
+  return p;
+}
+
+// De-identification masks (blanked eyes, faces): regions of exactly the image's minimum with
+// hard edges, which no scanner makes (real air blurs into tissue over a voxel). In each slice
+// across `axis`, a 4-connected region of the minimum whose edge is mostly denser than −200 HU
+// is tissue. Returns the count of voxels so marked in `tissue`.
+std::size_t mark_masked_regions(const Volume<float>& ct, const VoxelGrid& g, int axis,
+                                Mask& tissue) {
+  const float lowest = *std::min_element(ct.values.begin(), ct.values.end());
+  const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+  Mask seen(g.size(), 0);
+  std::vector<std::size_t> region, stack;
+  std::size_t marked = 0;
+  for (std::size_t s = 0; s < g.size(); ++s) {
+    if (seen[s] || ct.values[s] != lowest) continue;
+    region.clear();
+    stack.assign(1, s);
+    seen[s] = 1;
+    std::size_t hard = 0, soft = 0;
+    while (!stack.empty()) {
+      const std::size_t q = stack.back();
+      stack.pop_back();
+      region.push_back(q);
+      for (int a : {a1, a2}) {
+        const int c = g.coord(q, a);
+        for (int d : {-1, 1}) {
+          if (c + d < 0 || c + d >= g.n[a]) continue;
+          const std::size_t r = d < 0 ? q - g.stride[a] : q + g.stride[a];
+          if (ct.values[r] == lowest) {
+            if (!seen[r]) seen[r] = 1, stack.push_back(r);
+          } else {
+            ++(ct.values[r] > -200.0f ? hard : soft);
+          }
+        }
+      }
+    }
+    if (hard > soft && region.size() >= 16) {
+      for (std::size_t q : region) tissue[q] = 1;
+      marked += region.size();
+    }
+  }
+  return marked;
+}
+
+// The room air: what balls of `radius` reach from the scan's open sides without entering the
+// body closed at that radius (a morphological closing of the tissue: the nostrils, narrower than
+// the balls, are closed). Of the regions that touch the volume's border on the rim of one of its
+// faces, the largest is the room; an airway cut by the border (the nasopharynx at the bottom of
+// the scan) is enclosed by tissue on that face and is not a room seed.
+Mask room_air(const ImageFrame& frame, const VoxelGrid& g, const Mask& tissue, double radius,
+              int threads) {
+  const std::size_t n = g.size();
+  const double r2 = radius * radius;
+  std::vector<float> d2 = squared_distance(frame, tissue, OutsideIs::nothing, threads);
+  Mask far(n);
+  for (std::size_t q = 0; q < n; ++q) far[q] = d2[q] > r2;
+  d2 = squared_distance(frame, far, OutsideIs::nothing, threads);
+  Mask open(n);  // outside the closed body
+  for (std::size_t q = 0; q < n; ++q) open[q] = d2[q] <= r2;
+  d2 = {};
+  // Rim seeds: on each face of the box, the open voxels connected within the face to its edge.
+  std::vector<std::size_t> seeds;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int end : {0, g.n[axis] - 1}) {
+      const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+      auto at = [&](int u, int v) {
+        return g.stride[axis] * static_cast<std::size_t>(end) +
+               g.stride[a1] * static_cast<std::size_t>(u) +
+               g.stride[a2] * static_cast<std::size_t>(v);
+      };
+      Mask mark(static_cast<std::size_t>(g.n[a1]) * static_cast<std::size_t>(g.n[a2]), 0);
+      std::vector<std::pair<int, int>> stack;
+      auto push = [&](int u, int v) {
+        if (u < 0 || v < 0 || u >= g.n[a1] || v >= g.n[a2]) return;
+        const std::size_t m = static_cast<std::size_t>(u) + static_cast<std::size_t>(g.n[a1]) * v;
+        if (mark[m] || !open[at(u, v)]) return;
+        mark[m] = 1;
+        stack.emplace_back(u, v);
+      };
+      for (int u = 0; u < g.n[a1]; ++u) push(u, 0), push(u, g.n[a2] - 1);
+      for (int v = 0; v < g.n[a2]; ++v) push(0, v), push(g.n[a1] - 1, v);
+      while (!stack.empty()) {
+        const auto [u, v] = stack.back();
+        stack.pop_back();
+        seeds.push_back(at(u, v));
+        push(u + 1, v), push(u - 1, v), push(u, v + 1), push(u, v - 1);
+      }
+    }
+  // The largest 6-connected open region holding a seed.
+  Mask room(n, 0), label(n, 0);
+  std::size_t best = 0;
+  std::vector<std::size_t> members;
+  for (std::size_t s : seeds) {
+    if (label[s]) continue;
+    members.clear();
+    std::vector<std::size_t> stack{s};
+    label[s] = 1;
+    while (!stack.empty()) {
+      const std::size_t q = stack.back();
+      stack.pop_back();
+      members.push_back(q);
+      g.neighbours(q, [&](std::size_t r, int, int) {
+        if (!label[r] && open[r]) label[r] = 1, stack.push_back(r);
+      });
+    }
+    if (members.size() > best) {
+      best = members.size();
+      std::fill(room.begin(), room.end(), 0);
+      for (std::size_t q : members) room[q] = 1;
+    }
+  }
+  return room;
+}
+
+// A naris candidate: a 26-connected set of inner air voxels that face the room air.
+struct NarisVoxels {
+  Naris naris;
+  std::vector<std::size_t> voxels;
+  double widest = 0.0;  // the largest distance to tissue among its voxels (mm)
+};
+
+std::vector<NarisVoxels> find_nares(const ImageFrame& frame, const VoxelGrid& g, const Mask& inner,
+                                    const Mask& room, const std::vector<float>& depth,
+                                    double min_depth) {
+  const std::size_t n = g.size();
+  Mask faces(n, 0);
+  for (std::size_t q = 0; q < n; ++q) {
+    // Lumen, not the partial-volume rim along the skin: at least `min_depth` from tissue.
+    if (!inner[q] || depth[q] < min_depth) continue;
+    g.neighbours(q, [&](std::size_t r, int, int) { faces[q] |= room[r]; });
+  }
+  const Eigen::Matrix3d m = frame.index_to_physical();
+  const Eigen::Vector3d& s = frame.spacing;
+  const std::array<double, 3> face_area{s[1] * s[2], s[0] * s[2], s[0] * s[1]};
+  std::vector<NarisVoxels> out;
+  Mask seen(n, 0);
+  for (std::size_t s0 = 0; s0 < n; ++s0) {
+    if (!faces[s0] || seen[s0]) continue;
+    NarisVoxels c;
+    std::vector<std::size_t> stack{s0};
+    seen[s0] = 1;
+    Eigen::Vector3d weighted = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero();
+    while (!stack.empty()) {
+      const std::size_t q = stack.back();
+      stack.pop_back();
+      c.voxels.push_back(q);
+      c.widest = std::max(c.widest, static_cast<double>(depth[q]));
+      const Eigen::Vector3d ijk(g.coord(q, 0), g.coord(q, 1), g.coord(q, 2));
+      g.neighbours(q, [&](std::size_t r, int axis, int dir) {
+        if (!room[r]) return;
+        Eigen::Vector3d step = Eigen::Vector3d::Zero();
+        step[axis] = dir;
+        const Eigen::Vector3d out_dir = (m * step).normalized();
+        c.naris.area += face_area[axis];
+        weighted += face_area[axis] * frame.physical(ijk + 0.5 * step);
+        normal += face_area[axis] * out_dir;
+      });
+      // 26-neighbours among the facing voxels.
+      for (int dk = -1; dk <= 1; ++dk)
+        for (int dj = -1; dj <= 1; ++dj)
+          for (int di = -1; di <= 1; ++di) {
+            const int i = static_cast<int>(ijk[0]) + di, j = static_cast<int>(ijk[1]) + dj,
+                      k = static_cast<int>(ijk[2]) + dk;
+            if (i < 0 || j < 0 || k < 0 || i >= g.n[0] || j >= g.n[1] || k >= g.n[2]) continue;
+            const std::size_t r = frame.index(i, j, k);
+            if (faces[r] && !seen[r]) seen[r] = 1, stack.push_back(r);
+          }
+    }
+    c.naris.voxels = c.voxels.size();
+    c.naris.centre = weighted / c.naris.area;
+    c.naris.normal = normal.norm() > 0 ? normal.normalized() : Eigen::Vector3d::Zero();
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+// The distinct wide places of the airway: regional maxima of the distance to tissue whose
+// dynamics (how far the distance falls on the way to a wider place) is at least `h`. Found by
+// merging 6-connected components in decreasing distance (a union–find over the airway).
+std::vector<std::size_t> wide_places(const VoxelGrid& g, const Mask& airway,
+                                     const std::vector<float>& depth, double h) {
+  std::vector<std::size_t> order;
+  for (std::size_t q = 0; q < g.size(); ++q)
+    if (airway[q]) order.push_back(q);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return depth[a] > depth[b]; });
+  std::vector<std::int32_t> id(g.size(), -1);
+  std::vector<std::int32_t> parent(order.size());
+  std::vector<std::size_t> peak(order.size());  // per root: its deepest voxel
+  auto root = [&](std::int32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  std::vector<std::size_t> places;
+  for (std::size_t rank = 0; rank < order.size(); ++rank) {
+    const std::size_t q = order[rank];
+    auto self = static_cast<std::int32_t>(rank);
+    id[q] = self;
+    parent[self] = self;
+    peak[self] = q;
+    g.neighbours(q, [&](std::size_t r, int, int) {
+      if (id[r] < 0) return;
+      std::int32_t a = root(self), b = root(id[r]);
+      if (a == b) return;
+      // The lower peak dies here; it was a place of its own if it stood h above this level.
+      if (depth[peak[a]] > depth[peak[b]]) std::swap(a, b);
+      if (depth[peak[a]] - depth[q] >= h) places.push_back(peak[a]);
+      parent[a] = b;
+    });
+  }
+  // The deepest place of each remaining component never died.
+  for (std::size_t rank = 0; rank < order.size(); ++rank)
+    if (parent[rank] == static_cast<std::int32_t>(rank)) places.push_back(peak[rank]);
+  return places;
+}
+
+// For every airway voxel, the widest bottleneck of a path to it from the seeds: the largest,
+// over paths, of the smallest distance to tissue along the path.
+std::vector<float> bottleneck(const VoxelGrid& g, const Mask& airway,
+                              const std::vector<float>& depth,
+                              const std::vector<std::size_t>& seeds) {
+  std::vector<float> b(g.size(), -1.0f);
+  std::priority_queue<std::pair<float, std::size_t>> queue;
+  for (std::size_t s : seeds) b[s] = depth[s], queue.emplace(depth[s], s);
+  while (!queue.empty()) {
+    const auto [value, q] = queue.top();
+    queue.pop();
+    if (value < b[q]) continue;
+    g.neighbours(q, [&](std::size_t r, int, int) {
+      if (!airway[r]) return;
+      const float v = std::min(value, depth[r]);
+      if (v > b[r]) b[r] = v, queue.emplace(v, r);
+    });
+  }
+  return b;
+}
+
+// Seeded watershed: every airway voxel joins the seed it is reached from through the widest
+// bottleneck (ties: the first reached). Labels: 1 nasal, 2 sinus.
+Mask compete(const VoxelGrid& g, const Mask& airway, const std::vector<float>& depth,
+             const std::vector<std::pair<std::size_t, std::uint8_t>>& seeds) {
+  Mask label(g.size(), 0);
+  std::vector<float> b(g.size(), -1.0f);
+  std::priority_queue<std::pair<float, std::size_t>> queue;
+  for (const auto& [s, l] : seeds) label[s] = l, b[s] = depth[s], queue.emplace(depth[s], s);
+  while (!queue.empty()) {
+    const auto [value, q] = queue.top();
+    queue.pop();
+    if (value < b[q]) continue;
+    g.neighbours(q, [&](std::size_t r, int, int) {
+      if (!airway[r]) return;
+      const float v = std::min(value, depth[r]);
+      if (v > b[r]) b[r] = v, label[r] = label[q], queue.emplace(v, r);
+    });
+  }
+  return label;
+}
+
+// The two sides: each airway voxel goes to the naris it is nearest to along the airway (a
+// geodesic Voronoi split: the fronts meet at a gap in a thin septum and in the middle of the
+// nasopharynx). The choana is the last coronal slice, from the front, before the split runs
+// through open air (depth ≥ `open_depth` mm from the walls) rather than through a septum,
+// searched from 10 mm behind the nares.
+struct SideSplit {
+  Mask side;  // 1 right, 2 left
+  std::optional<int> choana;
+};
+SideSplit split_sides(const ImageFrame& frame, const VoxelGrid& g, const Mask& nasal,
+                      const std::vector<float>& depth, const std::vector<std::size_t>& right,
+                      const std::vector<std::size_t>& left, int ap, int ap_sign,
+                      double open_depth) {
+  SideSplit s;
+  s.side.assign(g.size(), 0);
+  std::vector<float> dist(g.size(), std::numeric_limits<float>::infinity());
+  using Item = std::pair<float, std::size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+  for (std::size_t q : right) dist[q] = 0.0f, s.side[q] = 1, queue.emplace(0.0f, q);
+  for (std::size_t q : left) dist[q] = 0.0f, s.side[q] = 2, queue.emplace(0.0f, q);
+  while (!queue.empty()) {
+    const auto [d, q] = queue.top();
+    queue.pop();
+    if (d > dist[q]) continue;
+    g.neighbours(q, [&](std::size_t r, int axis, int) {
+      if (!nasal[r]) return;
+      const float v = d + static_cast<float>(frame.spacing[axis]);
+      if (v < dist[r]) dist[r] = v, s.side[r] = s.side[q], queue.emplace(v, r);
+    });
+  }
+  // Per coronal slice: does the boundary between the sides pass through open air?
+  std::vector<int> open_pairs(static_cast<std::size_t>(g.n[ap]), 0);
+  for (std::size_t q = 0; q < g.size(); ++q) {
+    if (s.side[q] != 1) continue;
+    g.neighbours(q, [&](std::size_t r, int axis, int) {
+      if (axis != ap && s.side[r] == 2 && std::min(depth[q], depth[r]) >= open_depth)
+        ++open_pairs[static_cast<std::size_t>(g.coord(q, ap))];
+    });
+  }
+  // From 10 mm behind the nares (their vestibules may meet under the columella, in front).
+  int start = 0;
+  for (const auto* seeds : {&right, &left})
+    for (std::size_t q : *seeds) {
+      const int c = g.coord(q, ap);
+      start = std::max(start, ap_sign > 0 ? c : g.n[ap] - 1 - c);
+    }
+  start += static_cast<int>(std::ceil(10.0 / frame.spacing[ap]));
+  for (int t = start; t < g.n[ap]; ++t) {
+    const int slice = ap_sign > 0 ? t : g.n[ap] - 1 - t;
+    if (open_pairs[static_cast<std::size_t>(slice)] >= 3) {
+      s.choana = slice - ap_sign;
+      break;
+    }
+  }
+  return s;
+}
+
+std::string plane_text(const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
+  return fmt::format("p={:.3f},{:.3f},{:.3f};n={:.5f},{:.5f},{:.5f}", p[0], p[1], p[2], n[0], n[1],
+                     n[2]);
+}
+
+}  // namespace
+
+NasalSide parse_nasal_side(const std::string& text) {
+  if (text == "right") return NasalSide::right;
+  if (text == "left") return NasalSide::left;
+  if (text == "both") return NasalSide::both;
+  fail("side '{}' is not right, left or both", text);
+}
+
+const char* nasal_side_name(NasalSide side) {
+  constexpr const char* names[] = {"right", "left", "both"};
+  return names[static_cast<int>(side)];
+}
+
+double nasal_airway_threshold(const Volume<float>& ct) {
+  return 0.5 * air_threshold(ct);
+}
+
+NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptions& o) {
+  if (!(o.closing_radius > 0.0)) fail("the closing radius must be positive");
+  if (!(o.sinus_margin > 0.0)) fail("the sinus margin must be positive");
+  const ImageFrame& frame = ct.frame;
+  const VoxelGrid g(frame);
+  const std::size_t n = g.size();
+  const double voxel_ml = frame.spacing.prod() / 1000.0;
+  const PatientAxes axes = patient_axes(frame);
+  NasalAirway out;
+  out.threshold = o.threshold ? *o.threshold : nasal_airway_threshold(ct);
+  out.ap_axis = axes.axis[1];
+
+  Mask tissue(n);
+  for (std::size_t q = 0; q < n; ++q) tissue[q] = !(ct.values[q] < out.threshold);
+  out.masked_voxels = mark_masked_regions(ct, g, axes.axis[2], tissue);
+  const Mask room = room_air(frame, g, tissue, o.closing_radius, o.threads);
+  Mask inner(n);
+  std::size_t inner_count = 0, room_count = 0;
+  for (std::size_t q = 0; q < n; ++q) {
+    inner[q] = !tissue[q] && !room[q];
+    inner_count += inner[q];
+    room_count += room[q];
+  }
+  out.room_ml = static_cast<double>(room_count) * voxel_ml;
+  if (inner_count == 0)
+    fail("no air inside the body below {:.0f} HU: is this a head CT with its nasal airway?",
+         out.threshold);
+  std::vector<float> depth = squared_distance(frame, tissue, OutsideIs::nothing, o.threads);
+  for (float& d : depth) d = std::sqrt(d);
+
+  // The nares: inner air facing the room air through an opening wider than a voxel (a rim of
+  // partial-volume voxels around a region of room air is not an opening).
+  // Lumen is at least kLumenDepth from tissue (on any grid: thin-slice CTs resolve the skin's
+  // partial-volume rim in more voxels, not in more millimetres).
+  const double min_opening = std::max(kLumenDepth, frame.spacing.maxCoeff());
+  std::vector<NarisVoxels> candidates = find_nares(frame, g, inner, room, depth, min_opening);
+  // The nostrils open downwards (and forwards): an opening that faces more to the front or the
+  // side than to the feet is the mouth, a de-identification mask or the skin, not a naris.
+  std::erase_if(candidates, [&](const NarisVoxels& c) {
+    return c.widest < min_opening || c.naris.area < 4.0 * min_opening * min_opening ||
+           c.naris.normal[2] > -0.5;
+  });
+  if (candidates.empty())
+    fail(
+        "no naris found: no air inside the body opens downwards to the room air wider than "
+        "{:.1f} mm (is the nose inside the scan?)",
+        min_opening);
+  std::sort(candidates.begin(), candidates.end(),
+            [](const auto& a, const auto& b) { return a.naris.area > b.naris.area; });
+  // Right and left: the widest opening on each side of the airway's midline (x, LPS: left +).
+  std::vector<std::size_t> all_naris;
+  for (const auto& c : candidates)
+    all_naris.insert(all_naris.end(), c.voxels.begin(), c.voxels.end());
+  const Mask reached = flood(g, all_naris, [&](std::size_t q) { return inner[q] != 0; });
+  double mid_x = 0.0;
+  {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    std::size_t count = 0;
+    for (std::size_t q = 0; q < n; ++q)
+      if (reached[q]) sum += Eigen::Vector3d(g.coord(q, 0), g.coord(q, 1), g.coord(q, 2)), ++count;
+    mid_x = frame.physical(sum / static_cast<double>(count))[0];
+  }
+  const NarisVoxels* right = nullptr;
+  const NarisVoxels* left = nullptr;
+  for (const auto& c : candidates) {
+    const NarisVoxels*& slot = c.naris.centre[0] < mid_x ? right : left;
+    if (!slot) slot = &c;
+  }
+  if (right && left) mid_x = 0.5 * (right->naris.centre[0] + left->naris.centre[0]);
+  if (o.side == NasalSide::right && !right)
+    fail("no right naris found (the openings found lie left of the midline x = {:.1f} mm)", mid_x);
+  if (o.side == NasalSide::left && !left)
+    fail("no left naris found (the openings found lie right of the midline x = {:.1f} mm)", mid_x);
+  std::vector<std::size_t> naris_voxels;
+  for (const NarisVoxels* c : {right, left})
+    if (c) naris_voxels.insert(naris_voxels.end(), c->voxels.begin(), c->voxels.end());
+  const Mask airway = flood(g, naris_voxels, [&](std::size_t q) { return inner[q] != 0; });
+
+  // Sinuses: wide places reached only through a way in narrower by the margin, except the
+  // nasopharynx (the lowest wide place near the midline, below the airway's mean level).
+  const std::vector<float> way_in = bottleneck(g, airway, depth, naris_voxels);
+  const std::vector<std::size_t> places = wide_places(g, airway, depth, 0.5 * o.sinus_margin);
+  double mean_level = 0.0;
+  {
+    std::size_t count = 0;
+    for (std::size_t q = 0; q < n; ++q)
+      if (airway[q]) {
+        mean_level += frame.physical(Eigen::Vector3d(g.coord(q, 0), g.coord(q, 1), g.coord(q, 2)))
+                          .dot(Eigen::Vector3d::UnitZ());
+        ++count;
+      }
+    mean_level /= static_cast<double>(count);
+  }
+  auto position = [&](std::size_t q) {
+    return frame.physical(Eigen::Vector3d(g.coord(q, 0), g.coord(q, 1), g.coord(q, 2)));
+  };
+  std::optional<std::size_t> pharynx;
+  for (std::size_t p : places) {
+    const Eigen::Vector3d x = position(p);
+    if (depth[p] < 2.5 * o.sinus_margin || std::abs(x[0] - mid_x) > 15.0 || x[2] > mean_level)
+      continue;
+    if (!pharynx || x[2] < position(*pharynx)[2]) pharynx = p;
+  }
+  std::vector<std::pair<std::size_t, std::uint8_t>> seeds;
+  for (std::size_t q : naris_voxels) seeds.emplace_back(q, 1);
+  for (std::size_t p : places) {
+    const bool sinus = p != pharynx && depth[p] - way_in[p] >= o.sinus_margin;
+    seeds.emplace_back(p, sinus ? 2 : 1);
+    out.sinuses += sinus;
+  }
+  const Mask label = compete(g, airway, depth, seeds);
+  Mask nasal(n);
+  std::size_t sinus_count = 0;
+  for (std::size_t q = 0; q < n; ++q) {
+    nasal[q] = label[q] == 1;
+    sinus_count += label[q] == 2;
+  }
+  out.sinus_ml = static_cast<double>(sinus_count) * voxel_ml;
+
+  // The sides, separated by the septum down to the choana.
+  const int ap = axes.axis[1], ap_sign = axes.sign[1];
+  SideSplit split;
+  if (right && left) {
+    split =
+        split_sides(frame, g, nasal, depth, right->voxels, left->voxels, ap, ap_sign, min_opening);
+    out.choana = split.choana;
+  }
+  auto behind = [&](std::size_t q, int slice) {  // strictly posterior of `slice`
+    return ap_sign > 0 ? g.coord(q, ap) > slice : g.coord(q, ap) < slice;
+  };
+  const char axis_letter = static_cast<char>('i' + ap);
+  Mask result;
+  if (o.side == NasalSide::both) {
+    if (o.keep_nasopharynx || !out.choana) {
+      result = nasal;
+    } else {
+      // Both cavities end a little behind the choanae, where they have joined.
+      const int extra = static_cast<int>(std::ceil(5.0 / frame.spacing[ap]));
+      const int cut = std::clamp(*out.choana + ap_sign * extra, 0, g.n[ap] - 1);
+      result.assign(n, 0);
+      for (std::size_t q = 0; q < n; ++q) result[q] = nasal[q] && !behind(q, cut);
+      result = flood(g, naris_voxels, [&](std::size_t q) { return result[q] != 0; });
+      out.outlet = fmt::format("{}={}", axis_letter, cut);
+    }
+  } else {
+    const NarisVoxels* mine = o.side == NasalSide::right ? right : left;
+    const std::uint8_t my_side = o.side == NasalSide::right ? 1 : 2;
+    auto keep = [&](std::size_t q) {
+      if (!nasal[q]) return false;
+      if (!out.choana) return split.side.empty() || split.side[q] == my_side;
+      if (behind(q, *out.choana)) return o.keep_nasopharynx;
+      return split.side.empty() || split.side[q] == my_side;
+    };
+    result = flood(g, mine->voxels, keep);
+    if (right && left && !out.choana)
+      fail(
+          "the {} side cannot be separated: no choana found (the boundary between the sides "
+          "never runs through open air: is the nasopharynx in the scan?)",
+          nasal_side_name(o.side));
+    if (out.choana && !o.keep_nasopharynx)
+      out.outlet = fmt::format("{}={}", axis_letter, *out.choana);
+  }
+  // The inlet: the plane of the nares' openings (area-weighted), across the vestibule.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero();
+  double area = 0.0;
+  for (const NarisVoxels* c : {right, left}) {
+    if (!c || (o.side == NasalSide::right && c != right) ||
+        (o.side == NasalSide::left && c != left))
+      continue;
+    Naris naris = c->naris;
+    naris.right = c == right;
+    out.nares.push_back(naris);
+    centre += naris.area * naris.centre;
+    normal += naris.area * naris.normal;
+    area += naris.area;
+  }
+  out.inlet = plane_text(centre / area, normal.normalized());
+  // Air cut by the scan's border is closed there by a wall: no stray open patch for the mesher.
+  for (std::size_t q = 0; q < n; ++q)
+    for (int a = 0; a < 3; ++a)
+      if (g.coord(q, a) == 0 || g.coord(q, a) + 1 == g.n[a]) result[q] = 0;
+  std::size_t kept = 0;
+  for (auto v : result) kept += v;
+  out.volume_ml = static_cast<double>(kept) * voxel_ml;
+  out.mask.frame = frame;
+  out.mask.values = std::move(result);
+  return out;
+}
+
+}  // namespace naris

@@ -1,0 +1,144 @@
+// The nasal airway of real adult head CTs against expert labels (NasalSeg; Zhang et al. 2024,
+// CC BY 4.0: labels 3 right cavity, 4 left cavity, 5 nasopharynx), and its refusals.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "core/error.h"
+#include "mesh/image/nasal_airway.h"
+#include "mesh/image/read_volume.h"
+
+namespace naris {
+namespace {
+namespace fs = std::filesystem;
+
+struct Overlap {
+  double dice = 0.0, volume_ratio = 0.0;
+};
+Overlap overlap(const Volume<std::uint8_t>& mask, const Volume<float>& labels,
+                std::initializer_list<int> wanted) {
+  std::size_t a = 0, b = 0, both = 0;
+  for (std::size_t q = 0; q < mask.values.size(); ++q) {
+    bool in = false;
+    for (int l : wanted) in |= labels.values[q] == static_cast<float>(l);
+    a += mask.values[q];
+    b += in;
+    both += mask.values[q] && in;
+  }
+  return {2.0 * static_cast<double>(both) / static_cast<double>(a + b),
+          static_cast<double>(a) / static_cast<double>(b)};
+}
+
+// The last slice along j that holds the expert's right cavity (label 3): its choana.
+int expert_choana(const Volume<float>& labels) {
+  int last = -1;
+  for (int k = 0; k < labels.frame.dims[2]; ++k)
+    for (int j = 0; j < labels.frame.dims[1]; ++j)
+      for (int i = 0; i < labels.frame.dims[0]; ++i)
+        if (labels.at(i, j, k) == 3.0f) last = std::max(last, j);
+  return last;
+}
+
+class NasalSeg : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(NasalSeg, AirwayMatchesTheExpertLabels) {
+  const fs::path dir = fs::path(NARIS_SHARED_DATA) / "nasalseg";
+  const fs::path ct_file = dir / (std::string(GetParam()) + "_img.nrrd");
+  if (!fs::exists(ct_file)) GTEST_SKIP() << "shared data absent: " << ct_file;
+  const Volume<float> ct = read_volume(ct_file);
+  const Volume<float> labels = read_volume(dir / (std::string(GetParam()) + "_seg.nrrd"));
+
+  NasalAirwayOptions both;
+  both.side = NasalSide::both;
+  both.keep_nasopharynx = true;
+  const NasalAirway all = segment_nasal_airway(ct, both);
+  const Overlap o = overlap(all.mask, labels, {3, 4, 5});
+  EXPECT_GE(o.dice, 0.80) << "both cavities with the nasopharynx";
+  EXPECT_NEAR(o.volume_ratio, 1.0, 0.15);
+  ASSERT_EQ(all.nares.size(), 2u);
+  EXPECT_GT(all.sinus_ml, 20.0) << "the maxillary sinuses are left out";
+
+  const NasalAirway right = segment_nasal_airway(ct, NasalAirwayOptions{});
+  const Overlap r = overlap(right.mask, labels, {3});
+  // Below the 0.80 on P005 (docs/results/anatomy.md): this guards what holds today.
+  EXPECT_GE(r.dice, 0.75) << "right cavity";
+  EXPECT_NEAR(r.volume_ratio, 1.0, 0.15);
+  ASSERT_EQ(right.nares.size(), 1u);
+  EXPECT_TRUE(right.nares[0].right);
+  // An adult naris opens downwards, tens to a few hundred mm² of voxel faces.
+  EXPECT_LT(right.nares[0].normal[2], -0.5);
+  EXPECT_GT(right.nares[0].area, 20.0);
+  EXPECT_LT(right.nares[0].area, 400.0);
+  ASSERT_TRUE(right.choana.has_value());
+  EXPECT_NEAR(*right.choana, expert_choana(labels), 3);
+  EXPECT_EQ(right.outlet, "j=" + std::to_string(*right.choana));
+  // Nothing of the airway on the scan's border: the mesher closes it with wall.
+  const auto& d = right.mask.frame.dims;
+  for (int j = 0; j < d[1]; ++j)
+    for (int i = 0; i < d[0]; ++i) EXPECT_EQ(right.mask.at(i, j, d[2] - 1), 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Adults, NasalSeg, ::testing::Values("P005", "P045", "P055"));
+
+// Air with a scanner's noise (a constant would read as a de-identification mask).
+float air(int i, int j, int k) {
+  return -1000.0f + static_cast<float>((i * 13 + j * 7 + k * 3) % 17);
+}
+
+// A head without air inside: tissue in a box of room air wider than the closing's balls.
+Volume<float> solid_head() {
+  Volume<float> v;
+  v.frame.dims = {60, 60, 50};
+  v.frame.spacing = {1.0, 1.0, 1.0};
+  v.values.resize(v.frame.voxel_count());
+  for (int k = 0; k < 50; ++k)
+    for (int j = 0; j < 60; ++j)
+      for (int i = 0; i < 60; ++i) {
+        const bool head = k >= 15 && k < 35 && j >= 15 && j < 45 && i >= 15 && i < 45;
+        v.at(i, j, k) = head ? 40.0f + static_cast<float>((i * 7 + j * 3 + k) % 11) : air(i, j, k);
+      }
+  return v;
+}
+
+TEST(NasalAirway, RefusesAHeadWithoutAirInside) {
+  try {
+    segment_nasal_airway(solid_head(), NasalAirwayOptions{.threshold = -400.0});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no air inside the body"), std::string::npos) << e.what();
+  }
+}
+
+TEST(NasalAirway, RefusesAnInnerCavityWithoutANaris) {
+  Volume<float> v = solid_head();
+  for (int k = 22; k < 28; ++k)  // a closed cavity: air, but no opening to the room
+    for (int j = 22; j < 38; ++j)
+      for (int i = 22; i < 38; ++i) v.at(i, j, k) = air(i, j, k);
+  try {
+    segment_nasal_airway(v, NasalAirwayOptions{.threshold = -400.0});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no naris found"), std::string::npos) << e.what();
+  }
+}
+
+TEST(NasalAirway, FindsANostrilOpeningDownwardsAndRefusesTheMissingSide) {
+  Volume<float> v = solid_head();
+  for (int k = 22; k < 28; ++k)  // a cavity ...
+    for (int j = 22; j < 38; ++j)
+      for (int i = 22; i < 38; ++i) v.at(i, j, k) = air(i, j, k);
+  for (int k = 15; k < 22; ++k)  // ... and a nostril 6 mm wide through the floor, right of centre
+    for (int j = 24; j < 30; ++j)
+      for (int i = 22; i < 28; ++i) v.at(i, j, k) = air(i, j, k);
+  NasalAirwayOptions o{.threshold = -400.0};
+  const NasalAirway a = segment_nasal_airway(v, o);
+  ASSERT_EQ(a.nares.size(), 1u);
+  EXPECT_TRUE(a.nares[0].right);
+  EXPECT_LT(a.nares[0].normal[2], -0.9);
+  EXPECT_NEAR(a.volume_ml, (16.0 * 16 * 6 + 6.0 * 6 * 7) / 1000.0, 0.3 * (16.0 * 16 * 6) / 1000.0);
+  o.side = NasalSide::left;
+  EXPECT_THROW(segment_nasal_airway(v, o), Error);
+}
+
+}  // namespace
+}  // namespace naris
