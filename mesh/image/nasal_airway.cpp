@@ -15,7 +15,9 @@
 namespace naris {
 namespace {
 
-constexpr double kLumenDepth = 1.5;  // mm
+constexpr double kLumenDepth = 1.5;     // mm
+constexpr double kPlaceDynamics = 1.0;  // mm: a wide place stands this far above its saddle
+constexpr double kPharynxDepth = 5.0;   // mm: the nasopharynx is at least this wide
 
 using Mask = std::vector<std::uint8_t>;
 
@@ -416,7 +418,8 @@ double nasal_airway_threshold(const Volume<float>& ct) {
 
 NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptions& o) {
   if (!(o.closing_radius > 0.0)) fail("the closing radius must be positive");
-  if (!(o.sinus_margin > 0.0)) fail("the sinus margin must be positive");
+  if (!(o.sinus_margin > 0.0) || !(o.ethmoid_margin > 0.0))
+    fail("the sinus margins must be positive");
   const ImageFrame& frame = ct.frame;
   const VoxelGrid g(frame);
   const std::size_t n = g.size();
@@ -495,7 +498,7 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
   // Sinuses: wide places reached only through a way in narrower by the margin, except the
   // nasopharynx (the lowest wide place near the midline, below the airway's mean level).
   const std::vector<float> way_in = bottleneck(g, airway, depth, naris_voxels);
-  const std::vector<std::size_t> places = wide_places(g, airway, depth, 0.5 * o.sinus_margin);
+  const std::vector<std::size_t> places = wide_places(g, airway, depth, kPlaceDynamics);
   double mean_level = 0.0;
   {
     std::size_t count = 0;
@@ -513,14 +516,21 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
   std::optional<std::size_t> pharynx;
   for (std::size_t p : places) {
     const Eigen::Vector3d x = position(p);
-    if (depth[p] < 2.5 * o.sinus_margin || std::abs(x[0] - mid_x) > 15.0 || x[2] > mean_level)
-      continue;
+    if (depth[p] < kPharynxDepth || std::abs(x[0] - mid_x) > 15.0 || x[2] > mean_level) continue;
     if (!pharynx || x[2] < position(*pharynx)[2]) pharynx = p;
   }
+  double naris_level = 0.0, naris_area = 0.0;
+  for (const NarisVoxels* c : {right, left})
+    if (c) naris_level += c->naris.area * c->naris.centre[2], naris_area += c->naris.area;
+  naris_level /= naris_area;
   std::vector<std::pair<std::size_t, std::uint8_t>> seeds;
   for (std::size_t q : naris_voxels) seeds.emplace_back(q, 1);
   for (std::size_t p : places) {
-    const bool sinus = p != pharynx && depth[p] - way_in[p] >= o.sinus_margin;
+    // High above the nares only ethmoid (and frontal, sphenoid) cells are wide: any narrowing
+    // on their way in makes them sinuses.
+    const double margin =
+        position(p)[2] - naris_level > o.ethmoid_height ? o.ethmoid_margin : o.sinus_margin;
+    const bool sinus = p != pharynx && depth[p] - way_in[p] >= margin;
     seeds.emplace_back(p, sinus ? 2 : 1);
     out.sinuses += sinus;
   }
@@ -598,6 +608,24 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
   std::size_t kept = 0;
   for (auto v : result) kept += v;
   out.volume_ml = static_cast<double>(kept) * voxel_ml;
+  out.regions.frame = frame;
+  out.regions.values.assign(n, static_cast<std::uint8_t>(AirwayRegion::tissue));
+  for (std::size_t q = 0; q < n; ++q) {
+    AirwayRegion r = AirwayRegion::tissue;
+    if (result[q])
+      r = AirwayRegion::airway;
+    else if (label[q] == 2)
+      r = AirwayRegion::sinus;
+    else if (nasal[q])
+      r = AirwayRegion::excluded;
+    else if (room[q])
+      r = AirwayRegion::room;
+    else if (inner[q])
+      r = AirwayRegion::enclosed;
+    else if (tissue[q] && ct.values[q] < out.threshold)
+      r = AirwayRegion::masked;
+    out.regions.values[q] = static_cast<std::uint8_t>(r);
+  }
   out.mask.frame = frame;
   out.mask.values = std::move(result);
   return out;

@@ -24,8 +24,10 @@ struct NasalAirwayOptions {
   // The nasopharynx behind the choana: kept whole, or cut (one side ends at its choana; both
   // sides end a little behind the choanae, where they have joined).
   bool keep_nasopharynx = false;
-  double closing_radius = 5.0;  // mm: balls of this radius do not pass through a nostril
-  double sinus_margin = 2.0;    // mm: how much wider than its way in a cavity is to be a sinus
+  double closing_radius = 5.0;   // mm: balls of this radius do not pass through a nostril
+  double sinus_margin = 2.5;     // mm: how much wider than its way in a cavity is to be a sinus
+  double ethmoid_height = 25.0;  // mm above the nares: the ethmoid labyrinth, where ...
+  double ethmoid_margin = 0.5;   // mm: ... any narrowing on the way in makes a sinus
   int threads = 0;
 };
 
@@ -38,8 +40,20 @@ struct Naris {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, towards the room
 };
 
+// What each voxel of the scan became (NasalAirway::regions), for checking in 3D Slicer.
+enum class AirwayRegion : std::uint8_t {
+  tissue = 0,
+  airway = 1,    // the result
+  sinus = 2,     // reached from the nares, left out behind an ostium
+  room = 3,      // outside the body
+  excluded = 4,  // nasal air not kept: the other side, behind the choana, the scan's border
+  enclosed = 5,  // air inside the body not reached from the nares
+  masked = 6,    // a de-identification mask, taken for tissue
+};
+
 struct NasalAirway {
-  Volume<std::uint8_t> mask;  // 1: the airway
+  Volume<std::uint8_t> mask;     // 1: the airway
+  Volume<std::uint8_t> regions;  // AirwayRegion per voxel
   double threshold = 0.0;
   std::vector<Naris> nares;   // those the airway is entered by (one, or both)
   std::string inlet;          // cut plane p=…;n=… (mm) across the nares
