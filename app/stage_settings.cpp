@@ -71,7 +71,9 @@ SegmentJob SegmentSettings::resolve() const {
 
 MeshSettings::MeshSettings() {
   table.add("threshold", job.threshold, "inside is below T (CT air; see inside)");
-  table.add("label", job.label, "inside is the voxels equal to L (default for 0/1 labelmaps: 1)");
+  table.add("label", job.label,
+            "inside is the voxels with label L, or any of L1,L2,… (a union), by value or by the "
+            "segment names of a 3D Slicer segmentation (default for 0/1 labelmaps: 1)");
   table.add("inside", inside, "with a threshold: inside is 'below' or 'above' T")
       .one_of({"below", "above"});
   table.add("inlet", job.inlet,

@@ -93,6 +93,20 @@ InterpolateJobResult run_interpolate_job(const InterpolateJob& job) {
   r.inserted =
       job.insert ? *job.insert : std::max(0, static_cast<int>(std::lround(h / target)) - 1);
   r.mask = is_binary(v);
+  if (!r.mask && is_label_map(v)) {
+    // Labels are not intensities: HSR or a cross-fade would invent labels between two.
+    std::array<bool, 256> seen{};
+    for (float x : v.values) seen[static_cast<std::size_t>(x)] = true;
+    r.labels = static_cast<int>(std::count(seen.begin() + 1, seen.end(), true));
+    const Volume<float> out = interpolate_label_map(v, r.axis, r.inserted, job.threads);
+    r.after = out.frame;
+    Volume<std::uint8_t> labels;
+    labels.frame = out.frame;
+    labels.values.assign(out.values.begin(), out.values.end());
+    write_labelmap_nrrd(labels, job.output);
+    r.seconds = clock.seconds();
+    return r;
+  }
   if (job.method == SliceMethod::shape && !r.mask) {
     // Shape-based interpolation blends distance maps of segmented slices: the gray values are
     // segmented first at the air threshold, and the result is an airway labelmap.
@@ -116,12 +130,13 @@ std::string format_interpolate_summary(const InterpolateJob& job, const Interpol
   static const char* names[] = {"hsr", "linear", "shape"};
   std::string kind = r.mask ? "mask" : "gray values";
   if (r.binarized_at) kind = fmt::format("gray values segmented below {:.1f} HU", *r.binarized_at);
+  if (r.labels) kind = fmt::format("label map of {} labels, shape-based label by label", r.labels);
   return fmt::format(
       "naris interpolate: {} ({}), method {}\n  {} → {} voxels; spacing {} → {}\n"
       "  {} slice(s) inserted between each pair along {}\n  time {:.2f} s\n  wrote {}",
-      job.input.filename().string(), kind, names[static_cast<int>(job.method)], dims_text(r.before),
-      dims_text(r.after), spacing_text(r.before), spacing_text(r.after), r.inserted, "ijk"[r.axis],
-      r.seconds, job.output.string());
+      job.input.filename().string(), kind, r.labels ? "shape" : names[static_cast<int>(job.method)],
+      dims_text(r.before), dims_text(r.after), spacing_text(r.before), spacing_text(r.after),
+      r.inserted, "ijk"[r.axis], r.seconds, job.output.string());
 }
 
 SegmentJobResult run_segment_job(const SegmentJob& job) {
@@ -204,8 +219,12 @@ SegmentJobResult run_segment_job(const SegmentJob& job) {
                        {"opening_mm2", significant(n.area, 5)},
                        {"centre_mm", {n.centre[0], n.centre[1], n.centre[2]}},
                        {"normal", {n.normal[0], n.normal[1], n.normal[2]}}});
+    const fs::path regions = segmentation_regions(job.output);
+    sidecar["regions"] = regions.filename().string();
+    write_labelmap_nrrd(nasal.regions, regions);
     write_json_file(segmentation_sidecar(job.output), sidecar);
     nasal.mask = {};
+    nasal.regions = {};
     r.nasal = std::move(nasal);
     r.seconds = clock.seconds();
     return r;
@@ -239,6 +258,11 @@ fs::path segmentation_sidecar(const fs::path& labelmap) {
   return p.replace_extension(".json");
 }
 
+fs::path segmentation_regions(const fs::path& labelmap) {
+  fs::path p = segmentation_sidecar(labelmap);
+  return p.replace_filename(p.stem().string() + "-regions.nrrd");
+}
+
 std::string format_segment_summary(const SegmentJob& job, const SegmentJobResult& r) {
   const double voxel_ml = r.frame.spacing.prod() / 1000.0;
   if (r.nasal) {
@@ -251,14 +275,15 @@ std::string format_segment_summary(const SegmentJob& job, const SegmentJobResult
     return fmt::format(
         "naris segment: {} ({}, {}), nasal airway, {} side(s), nasopharynx {}\n  threshold {:.1f} "
         "HU ({})\n  airway {:.2f} mL; left out: {} sinus cavities ({:.1f} mL), room air {:.0f} "
-        "mL{}{}\n  inlet {}\n  outlet {}\n  time {:.2f} s\n  wrote {} and {}",
+        "mL{}{}\n  inlet {}\n  outlet {}\n  time {:.2f} s\n  wrote {}, {} and {}",
         job.input.filename().string(), dims_text(r.frame), spacing_text(r.frame),
         nasal_side_name(job.side), job.keep_nasopharynx ? "kept" : "cut", r.threshold,
         job.threshold == "auto" ? "automatic" : "given", a.volume_ml, a.sinuses, a.sinus_ml,
         a.room_ml,
         a.masked_voxels ? fmt::format("; {} masked voxels taken for tissue", a.masked_voxels) : "",
         nares, a.inlet, a.outlet.empty() ? "(none: give one to the mesher)" : a.outlet, r.seconds,
-        job.output.string(), segmentation_sidecar(job.output).string());
+        job.output.string(), segmentation_sidecar(job.output).string(),
+        segmentation_regions(job.output).string());
   }
   return fmt::format(
       "naris segment: {} ({}, {}, {})\n  threshold {:.1f} HU ({}), inside {}\n  airway {} voxels, "

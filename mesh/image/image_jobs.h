@@ -44,6 +44,7 @@ struct InterpolateJob {
 struct InterpolateJobResult {
   int axis = 2, inserted = 0;
   bool mask = false;
+  int labels = 0;  // a label map's non-zero labels (interpolated label by label)
   std::optional<double> binarized_at;  // shape-based on gray values: the air threshold used
   ImageFrame before, after;
   double seconds = 0.0;
@@ -77,6 +78,8 @@ struct SegmentJobResult {
 };
 // The sidecar of a segmentation: <output without its extension>.json.
 std::filesystem::path segmentation_sidecar(const std::filesystem::path& labelmap);
+// What every voxel became (AirwayRegion): <output without its extension>-regions.nrrd.
+std::filesystem::path segmentation_regions(const std::filesystem::path& labelmap);
 SegmentJobResult run_segment_job(const SegmentJob& job);
 std::string format_segment_summary(const SegmentJob& job, const SegmentJobResult& r);
 

@@ -1,7 +1,9 @@
 #include "mesh/image/interpolate_slices.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <cmath>
 #include <thread>
 
 #include "core/error.h"
@@ -55,6 +57,68 @@ void set_slice_across(Volume<float>& v, int axis, int index, const Image2D& im) 
   for_each_in_slice(v.dims(), axis, index, [&](int x, int y, int i, int j, int k) {
     v.at(i, j, k) = static_cast<float>(im.at(x, y));
   });
+}
+
+bool is_label_map(const Volume<float>& v) {
+  std::array<bool, 256> seen{};
+  for (float x : v.values) {
+    if (!(x >= 0.0f && x <= 255.0f) || x != std::floor(x)) return false;
+    seen[static_cast<std::size_t>(x)] = true;
+  }
+  return std::count(seen.begin() + 1, seen.end(), true) > 1;
+}
+
+Volume<float> interpolate_label_map(const Volume<float>& v, int axis, int k, int threads) {
+  if (axis < 0 || axis > 2) fail("slice axis must be 0, 1 or 2 (i, j or k)");
+  if (k < 0) fail("the number of slices to insert must not be negative");
+  const int n = v.dims()[axis];
+  if (n < 2) fail("a volume with a single slice along axis {} cannot be interpolated", axis);
+  std::array<bool, 256> seen{};
+  for (float x : v.values) seen[static_cast<std::size_t>(x)] = true;
+  std::vector<double> labels;
+  for (int l = 1; l < 256; ++l)
+    if (seen[static_cast<std::size_t>(l)]) labels.push_back(l);
+  Volume<float> out;
+  out.frame = v.frame;
+  out.frame.dims[axis] = (n - 1) * (k + 1) + 1;
+  out.frame.spacing[axis] /= (k + 1);
+  out.values.assign(out.frame.voxel_count(), 0.0f);
+  auto mask_of = [](const Image2D& im, double label) {
+    Image2D m = im;
+    for (double& x : m.v) x = x == label ? 1.0 : 0.0;
+    return m;
+  };
+  std::atomic<int> next{0};
+  auto worker = [&] {
+    std::vector<Image2D> da(labels.size()), db(labels.size());
+    for (int p; (p = next++) < n - 1;) {
+      const Image2D a = slice_across(v, axis, p), b = slice_across(v, axis, p + 1);
+      set_slice_across(out, axis, p * (k + 1), a);
+      if (p + 1 == n - 1) set_slice_across(out, axis, (p + 1) * (k + 1), b);
+      if (k == 0) continue;
+      for (std::size_t l = 0; l < labels.size(); ++l) {
+        da[l] = signed_distance(mask_of(a, labels[l]));
+        db[l] = signed_distance(mask_of(b, labels[l]));
+      }
+      for (int q = 1; q <= k; ++q) {
+        const double s = static_cast<double>(q) / (k + 1);
+        Image2D im{a.width, a.height, std::vector<double>(a.v.size(), 0.0)};
+        for (std::size_t px = 0; px < im.v.size(); ++px) {
+          double best = 0.0;
+          for (std::size_t l = 0; l < labels.size(); ++l) {
+            const double d = (1 - s) * da[l].v[px] + s * db[l].v[px];
+            if (d > best) best = d, im.v[px] = labels[l];
+          }
+        }
+        set_slice_across(out, axis, p * (k + 1) + q, im);
+      }
+    }
+  };
+  const unsigned count = thread_count(threads);
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < count; ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  return out;
 }
 
 Volume<float> interpolate_slices(const Volume<float>& v, int axis, int k, SliceMethod method,

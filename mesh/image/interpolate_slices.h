@@ -17,6 +17,14 @@ SliceMethod parse_slice_method(const std::string& name);
 Volume<float> interpolate_slices(const Volume<float>& v, int axis, int k, SliceMethod method,
                                  const HsrOptions& hsr = {}, int threads = 0);
 
+// A label map: integer labels 0 … 255 with more than one non-zero label (3D Slicer's
+// multi-segment maps; 0 is the background).
+bool is_label_map(const Volume<float>& v);
+
+// Shape-based interpolation of a label map, label by label: each new voxel takes the label whose
+// interpolated signed distance is the most inside, or 0 where no label's is inside.
+Volume<float> interpolate_label_map(const Volume<float>& v, int axis, int k, int threads = 0);
+
 // Slice `index` across `axis` as a 2D image (and back).
 Image2D slice_across(const Volume<float>& v, int axis, int index);
 void set_slice_across(Volume<float>& v, int axis, int index, const Image2D& im);

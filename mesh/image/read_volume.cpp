@@ -89,6 +89,35 @@ void read_nrrd_frame(const fs::path& path, ImageFrame& frame) {
   }
 }
 
+// 3D Slicer's segmentation NRRD names its segments in key:=value lines of the header:
+// SegmentN_Name and SegmentN_LabelValue (the label value defaults to N + 1).
+std::map<int, std::string> read_nrrd_label_names(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::map<int, std::string> names, values;
+  const std::regex field(R"(^Segment(\d+)_(Name|LabelValue):=(.*)$)");
+  std::string line;
+  std::smatch m;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) break;
+    if (!std::regex_match(line, m, field)) continue;
+    (m[2] == "Name" ? names : values)[std::stoi(m[1])] = m[3];
+  }
+  std::map<int, std::string> out;
+  for (const auto& [segment, name] : names) {
+    int label = segment + 1;
+    if (const auto it = values.find(segment); it != values.end()) {
+      try {
+        label = std::stoi(it->second);
+      } catch (const std::exception&) {
+        fail("{}: Segment{}_LabelValue '{}' is not a number", path.string(), segment, it->second);
+      }
+    }
+    out[label] = name;
+  }
+  return out;
+}
+
 // vtkNrrdReader does not notice a truncated payload (it hands back what it could read), so the
 // payload length is checked here: the inflated size for gzip, the file size for raw data.
 void check_nrrd_payload(const fs::path& path, std::size_t expected_bytes) {
@@ -174,6 +203,7 @@ Volume<float> read_volume(const fs::path& path, VolumeInfo* info) {
       fail("{}: not a readable NRRD file (bad magic or header)", path.string());
     run(reader);
     read_nrrd_frame(path, frame);
+    meta.label_names = read_nrrd_label_names(path);
     frame_from_header = true;
   } else if (ext == ".nii" || ext == ".nii.gz") {
     meta.format = "nifti";

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <set>
 
@@ -22,15 +23,64 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Decides what "inside" means and checks that it selects something but not everything.
-mve::VolumeField make_field(const Volume<float>& volume, const MeshJob& job, MeshJobResult& r) {
+// The labels of "3,5" or of segment names, each checked against what the image holds.
+std::vector<int> parse_labels(const std::string& text, const Volume<float>& volume,
+                              const MeshJob& job, const VolumeInfo& info) {
+  std::set<int> present;
+  for (float v : volume.values)
+    if (v == std::floor(v) && std::abs(v) < 1e6f) present.insert(static_cast<int>(v));
+  auto known = [&] {
+    std::string list;
+    for (int l : present) {
+      const auto it = info.label_names.find(l);
+      list += fmt::format("{}{}{}", list.empty() ? "" : ", ", l,
+                          it == info.label_names.end() ? "" : " (" + it->second + ")");
+    }
+    return list;
+  };
+  std::vector<int> labels;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    std::string token = text.substr(start, comma - start);
+    token.erase(0, token.find_first_not_of(' '));
+    token.erase(token.find_last_not_of(' ') + 1);
+    start = comma + 1;
+    if (token.empty()) fail("label '{}': an empty item (give L or L1,L2,…)", text);
+    int label = 0;
+    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), label);
+    if (ec != std::errc() || end != token.data() + token.size()) {
+      const auto it = std::find_if(info.label_names.begin(), info.label_names.end(),
+                                   [&](const auto& kv) { return kv.second == token; });
+      if (it == info.label_names.end())
+        fail("{}: no label '{}' (labels present: {})", job.input.string(), token, known());
+      label = it->first;
+    }
+    if (!present.count(label))
+      fail("{}: empty segmentation: no voxel has label {} (labels present: {})", job.input.string(),
+           label, known());
+    labels.push_back(label);
+  }
+  return labels;
+}
+
+// Decides what "inside" means and checks that it selects something but not everything. A union
+// of labels turns the image into its 0/1 mask.
+mve::VolumeField make_field(Volume<float>& volume, const MeshJob& job, MeshJobResult& r) {
   const auto& info = r.input;
   InsideRule mode;
   double level;
   if (job.threshold && job.label) fail("give either --threshold or --label, not both");
   if (job.label) {
     mode = InsideRule::label;
-    level = *job.label;
+    r.labels = parse_labels(*job.label, volume, job, info);
+    level = r.labels.front();
+    if (r.labels.size() > 1) {
+      const std::set<int> set(r.labels.begin(), r.labels.end());
+      for (float& v : volume.values)
+        v = v == std::floor(v) && set.count(static_cast<int>(v)) ? 1.0f : 0.0f;
+      level = 1.0;
+    }
   } else if (job.threshold) {
     level = *job.threshold;
     if (!(level > info.min_value && level < info.max_value))
@@ -126,7 +176,7 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
   for (const auto& text : job.regions) regions.push_back(parse_region(text));
 
   Stopwatch clock;
-  const Volume<float> volume = read_volume(job.input, &r.input);
+  Volume<float> volume = read_volume(job.input, &r.input);
   r.seconds.push_back({"read", clock.seconds()});
 
   clock = Stopwatch();
@@ -257,8 +307,10 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
       "naris mesh: {} ({}, {})\n  cells     {} = {} hex + {} pyramid + {} tet\n"
       "  nodes     {}\n  volume    {:.1f} mm³ ({:.3f} mL)\n",
       job.input.filename().string(), r.input.format,
-      r.rule == InsideRule::label ? fmt::format("label {}", r.level)
-                                  : fmt::format("inside {} {}", inside_rule_name(r.rule), r.level),
+      r.labels.size() > 1 ? fmt::format("labels {}", fmt::join(r.labels, " + "))
+      : r.rule == InsideRule::label
+          ? fmt::format("label {}", r.level)
+          : fmt::format("inside {} {}", inside_rule_name(r.rule), r.level),
       m.cell_count(), m.hexes.size(), m.pyramids.size(), m.tets.size(), m.nodes.size(), r.volume,
       r.volume / 1000.0);
   if (r.mve.dropped_components)

@@ -19,8 +19,9 @@ namespace naris {
 
 struct MeshJob {
   std::filesystem::path input;
-  std::optional<double> threshold;        // inside is below it by default (air in CT)
-  std::optional<double> label;            // inside is exactly this value
+  std::optional<double> threshold;  // inside is below it by default (air in CT)
+  // Inside is one of these labels: "3", "3,5" (a union), or segment names ("right cavity").
+  std::optional<std::string> label;
   InsideRule inside = InsideRule::below;  // with a threshold: its side (below or above)
   std::optional<std::string> inlet, outlet;
   std::vector<std::string> regions;  // name:box=... or name:sphere=...
@@ -40,6 +41,7 @@ struct MeshJobResult {
   HybridMesh mesh;
   VolumeInfo input;
   double level = 0.0;                   // the threshold or label used
+  std::vector<int> labels;              // a union of labels, meshed as one mask
   InsideRule rule = InsideRule::label;  // what inside meant
   mve::MveStats mve;
   ImproveStats improvement;

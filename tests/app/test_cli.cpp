@@ -1135,6 +1135,7 @@ TEST_F(Cli, NasalSegRightCavityFromTheCtToTheMesh) {
   CliRun r = naris("segment " + ct.string() + " --airway nasal --side right -o " + airway.string());
   ASSERT_EQ(r.status, 0) << r.err;
   ASSERT_TRUE(fs::exists(dir_ / "airway.json"));
+  ASSERT_TRUE(fs::exists(dir_ / "airway-regions.nrrd"));
   r = naris("mesh " + airway.string() + " --inlet auto --outlet auto -o " +
             (dir_ / "mesh" / "mesh.h5").string());
   ASSERT_EQ(r.status, 0) << r.err;
@@ -1167,4 +1168,46 @@ TEST_F(Cli, NasalAirwayRefusesSeedsLabelmapsAndStrayOptions) {
   expect_clean_failure(naris("segment " + scan.string() + " --side left" + o), "airway nasal");
   expect_clean_failure(naris("segment " + scan.string() + " --airway nasal --side up" + o), "side");
   expect_clean_failure(naris("mesh " + labels.string() + " --inlet auto " + out()), "auto");
+}
+
+// A label map of two touching halves of a ball (labels 3 and 5) with 3D Slicer's segment names:
+// --label 3,5 meshes their union as one object, a name selects its label, an absent label or
+// name is an error that lists what is there, and interpolate keeps it a label map.
+TEST_F(Cli, LabelsUnionsNamesAndLabelMapInterpolation) {
+  std::vector<std::uint8_t> v = ball_labels();
+  for (std::size_t q = 0; q < v.size(); ++q)
+    if (v[q]) v[q] = (q % 12) < 6 ? 3 : 5;
+  const fs::path in = dir_ / "in" / "halves.nrrd";
+  {
+    std::ofstream out(in, std::ios::binary);
+    out << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 12 12 12\nencoding: raw\n"
+           "Segment0_Name:=right half\nSegment0_LabelValue:=3\n"
+           "Segment1_Name:=left half\nSegment1_LabelValue:=5\n\n"
+        << payload(v);
+  }
+  auto volume = [](const fs::path& folder) {
+    std::ifstream file(folder / "mesh.json");
+    return nlohmann::json::parse(file)["volume_mm3"].get<double>();
+  };
+  const fs::path both = dir_ / "both", right = dir_ / "right", left = dir_ / "left";
+  CliRun r = naris("mesh " + in.string() + " --label 3,5 -o " + (both / "mesh.h5").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("labels 3 + 5"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("dropped"), std::string::npos) << "the union is one object: " << r.err;
+  r = naris("mesh " + in.string() + " --label 'right half' -o " + (right / "mesh.h5").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = naris("mesh " + in.string() + " --label 5 -o " + (left / "mesh.h5").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  // The halves' walls meet inside the union: their volumes add up to about the whole.
+  EXPECT_NEAR(volume(right) + volume(left), volume(both), 0.15 * volume(both));
+  EXPECT_GT(volume(both), volume(right));
+  expect_clean_failure(naris("mesh " + in.string() + " --label 3,4 " + out()),
+                       "no voxel has label 4 (labels present: 0, 3 (right half), 5 (left half))");
+  expect_clean_failure(naris("mesh " + in.string() + " --label nose " + out()), "no label 'nose'");
+  const fs::path fine = dir_ / "fine.nrrd";
+  r = naris("interpolate " + in.string() + " --insert 1 -o " + fine.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("label map of 2 labels"), std::string::npos) << r.err;
+  r = naris("mesh " + fine.string() + " --label 5 -o " + (dir_ / "fine" / "mesh.h5").string());
+  EXPECT_EQ(r.status, 0) << r.err;
 }

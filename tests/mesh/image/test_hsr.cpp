@@ -150,3 +150,43 @@ TEST(InterpolateSlices, HsrBeatsLinearOnTheNeonateLeavingSlicesOut) {
 
 }  // namespace
 }  // namespace naris
+
+namespace naris {
+namespace {
+
+// Two labels side by side in a cylinder whose radius changes from slice to slice: the label map
+// interpolated label by label keeps each label's volume to within a voxel layer, invents no
+// label, and keeps the acquired slices.
+TEST(LabelMap, InterpolatesLabelByLabel) {
+  Volume<float> v;
+  v.frame.dims = {40, 40, 5};
+  v.frame.spacing = {0.5, 0.5, 1.5};
+  v.values.assign(v.frame.voxel_count(), 0.0f);
+  for (int k = 0; k < 5; ++k)
+    for (int j = 0; j < 40; ++j)
+      for (int i = 0; i < 40; ++i)
+        if (std::hypot(i - 19.5, j - 19.5) < 10.0 + 2.0 * k) v.at(i, j, k) = i < 20 ? 3.0f : 5.0f;
+  ASSERT_TRUE(is_label_map(v));
+  Volume<float> binary = v;
+  for (float& x : binary.values) x = x > 0.0f ? 1.0f : 0.0f;
+  EXPECT_FALSE(is_label_map(binary));
+  const Volume<float> out = interpolate_label_map(v, 2, 2, 2);
+  ASSERT_EQ(out.frame.dims[2], 13);
+  EXPECT_DOUBLE_EQ(out.frame.spacing[2], 0.5);
+  double count3 = 0.0, count5 = 0.0;
+  for (float x : out.values) {
+    EXPECT_TRUE(x == 0.0f || x == 3.0f || x == 5.0f) << x;
+    count3 += x == 3.0f, count5 += x == 5.0f;
+  }
+  for (int k = 0; k < 5; ++k)
+    for (int j = 0; j < 40; ++j)
+      for (int i = 0; i < 40; ++i) EXPECT_EQ(out.at(i, j, 3 * k), v.at(i, j, k));
+  // Each label is half of a disc whose radius grows linearly, 10 + 2z pixels at slice z.
+  double voxels = 0.0;
+  for (int q = 0; q < 13; ++q) voxels += 0.5 * M_PI * std::pow(10.0 + 2.0 * q / 3.0, 2);
+  EXPECT_NEAR(count3, voxels, 0.05 * voxels);
+  EXPECT_NEAR(count5, voxels, 0.05 * voxels);
+}
+
+}  // namespace
+}  // namespace naris
