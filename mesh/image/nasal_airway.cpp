@@ -33,6 +33,9 @@ struct VoxelGrid {
   int coord(std::size_t q, int axis) const {
     return static_cast<int>(q / stride[axis] % static_cast<std::size_t>(n[axis]));
   }
+  Eigen::Vector3d ijk(std::size_t q) const {
+    return Eigen::Vector3d(coord(q, 0), coord(q, 1), coord(q, 2));
+  }
   template <class F>
   void neighbours(std::size_t q, F&& f) const {
     for (int a = 0; a < 3; ++a) {
@@ -225,7 +228,7 @@ std::vector<NarisVoxels> find_nares(const ImageFrame& frame, const VoxelGrid& g,
       stack.pop_back();
       c.voxels.push_back(q);
       c.widest = std::max(c.widest, static_cast<double>(depth[q]));
-      const Eigen::Vector3d ijk(g.coord(q, 0), g.coord(q, 1), g.coord(q, 2));
+      const Eigen::Vector3d ijk = g.ijk(q);
       g.neighbours(q, [&](std::size_t r, int axis, int dir) {
         if (!room[r]) return;
         Eigen::Vector3d step = Eigen::Vector3d::Zero();
@@ -398,6 +401,143 @@ std::string plane_text(const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
                      n[2]);
 }
 
+// The nares: the widest downward opening of the lumen to the room air on each side of the
+// airway's midline. Owns the candidates the pointers point into.
+struct Nares {
+  std::vector<NarisVoxels> candidates;
+  const NarisVoxels* right = nullptr;
+  const NarisVoxels* left = nullptr;
+  double mid_x = 0.0;               // the midline between them (x, LPS: left +)
+  std::vector<std::size_t> voxels;  // of both
+  double level = 0.0;               // their area-weighted height (z)
+};
+
+Nares choose_nares(const ImageFrame& frame, const VoxelGrid& g, const Mask& inner, const Mask& room,
+                   const std::vector<float>& depth, NasalSide side) {
+  // Lumen is at least kLumenDepth from tissue (on any grid: thin-slice CTs resolve the skin's
+  // partial-volume rim in more voxels, not in more millimetres).
+  const double min_opening = std::max(kLumenDepth, frame.spacing.maxCoeff());
+  Nares nares;
+  nares.candidates = find_nares(frame, g, inner, room, depth, min_opening);
+  // The nostrils open downwards (and forwards): an opening that faces more to the front or the
+  // side than to the feet is the mouth, a de-identification mask or the skin, not a naris.
+  std::erase_if(nares.candidates, [&](const NarisVoxels& c) {
+    return c.widest < min_opening || c.naris.area < 4.0 * min_opening * min_opening ||
+           c.naris.normal[2] > -0.5;
+  });
+  if (nares.candidates.empty())
+    fail(
+        "no naris found: no air inside the body opens downwards to the room air wider than "
+        "{:.1f} mm (is the nose inside the scan?)",
+        min_opening);
+  std::sort(nares.candidates.begin(), nares.candidates.end(),
+            [](const auto& a, const auto& b) { return a.naris.area > b.naris.area; });
+  std::vector<std::size_t> all;
+  for (const auto& c : nares.candidates) all.insert(all.end(), c.voxels.begin(), c.voxels.end());
+  const Mask reached = flood(g, all, [&](std::size_t q) { return inner[q] != 0; });
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  std::size_t count = 0;
+  for (std::size_t q = 0; q < g.size(); ++q)
+    if (reached[q]) sum += g.ijk(q), ++count;
+  nares.mid_x = frame.physical(sum / static_cast<double>(count))[0];
+  for (const auto& c : nares.candidates) {
+    const NarisVoxels*& slot = c.naris.centre[0] < nares.mid_x ? nares.right : nares.left;
+    if (!slot) slot = &c;
+  }
+  if (nares.right && nares.left)
+    nares.mid_x = 0.5 * (nares.right->naris.centre[0] + nares.left->naris.centre[0]);
+  if (side == NasalSide::right && !nares.right)
+    fail("no right naris found (the openings found lie left of the midline x = {:.1f} mm)",
+         nares.mid_x);
+  if (side == NasalSide::left && !nares.left)
+    fail("no left naris found (the openings found lie right of the midline x = {:.1f} mm)",
+         nares.mid_x);
+  double area = 0.0;
+  for (const NarisVoxels* c : {nares.right, nares.left})
+    if (c) {
+      nares.voxels.insert(nares.voxels.end(), c->voxels.begin(), c->voxels.end());
+      nares.level += c->naris.area * c->naris.centre[2];
+      area += c->naris.area;
+    }
+  nares.level /= area;
+  return nares;
+}
+
+// Sinuses: wide places reached only through a way in narrower by the margin, except the
+// nasopharynx (the lowest wide place near the midline, below the airway's mean level); high
+// above the nares only ethmoid (and frontal, sphenoid) cells are wide, and any narrowing on
+// their way in makes them sinuses. Returns each airway voxel's label: 1 nasal, 2 sinus.
+Mask separate_sinuses(const ImageFrame& frame, const VoxelGrid& g, const Mask& airway,
+                      const std::vector<float>& depth, const Nares& nares,
+                      const NasalAirwayOptions& o, std::size_t& sinuses) {
+  const std::vector<float> way_in = bottleneck(g, airway, depth, nares.voxels);
+  const std::vector<std::size_t> places = wide_places(g, airway, depth, kPlaceDynamics);
+  auto position = [&](std::size_t q) { return frame.physical(g.ijk(q)); };
+  double mean_level = 0.0;
+  std::size_t count = 0;
+  for (std::size_t q = 0; q < g.size(); ++q)
+    if (airway[q]) mean_level += position(q)[2], ++count;
+  mean_level /= static_cast<double>(count);
+  std::optional<std::size_t> pharynx;
+  for (std::size_t p : places) {
+    const Eigen::Vector3d x = position(p);
+    if (depth[p] < kPharynxDepth || std::abs(x[0] - nares.mid_x) > 15.0 || x[2] > mean_level)
+      continue;
+    if (!pharynx || x[2] < position(*pharynx)[2]) pharynx = p;
+  }
+  std::vector<std::pair<std::size_t, std::uint8_t>> seeds;
+  for (std::size_t q : nares.voxels) seeds.emplace_back(q, 1);
+  sinuses = 0;
+  for (std::size_t p : places) {
+    const double margin =
+        position(p)[2] - nares.level > o.ethmoid_height ? o.ethmoid_margin : o.sinus_margin;
+    const bool sinus = p != pharynx && depth[p] - way_in[p] >= margin;
+    seeds.emplace_back(p, sinus ? 2 : 1);
+    sinuses += sinus;
+  }
+  return compete(g, airway, depth, seeds);
+}
+
+// The side or sides asked for, with the choana (out.choana) and the outlet plane (out.outlet).
+Mask select_side(const ImageFrame& frame, const VoxelGrid& g, const Mask& nasal,
+                 const std::vector<float>& depth, const Nares& nares, const NasalAirwayOptions& o,
+                 const PatientAxes& axes, NasalAirway& out) {
+  const int ap = axes.axis[1], ap_sign = axes.sign[1];
+  SideSplit split;
+  if (nares.right && nares.left) {
+    split = split_sides(frame, g, nasal, depth, nares.right->voxels, nares.left->voxels, ap,
+                        ap_sign, std::max(kLumenDepth, frame.spacing.maxCoeff()));
+    out.choana = split.choana;
+  }
+  auto behind = [&](std::size_t q, int slice) {  // strictly posterior of `slice`
+    return ap_sign > 0 ? g.coord(q, ap) > slice : g.coord(q, ap) < slice;
+  };
+  const char axis_letter = static_cast<char>('i' + ap);
+  if (o.side == NasalSide::both) {
+    if (o.keep_nasopharynx || !out.choana) return nasal;
+    // Both cavities end a little behind the choanae, where they have joined.
+    const int extra = static_cast<int>(std::ceil(5.0 / frame.spacing[ap]));
+    const int cut = std::clamp(*out.choana + ap_sign * extra, 0, g.n[ap] - 1);
+    out.outlet = fmt::format("{}={}", axis_letter, cut);
+    return flood(g, nares.voxels, [&](std::size_t q) { return nasal[q] && !behind(q, cut); });
+  }
+  if (nares.right && nares.left && !out.choana)
+    fail(
+        "the {} side cannot be separated: no choana found (the boundary between the sides never "
+        "runs through open air: is the nasopharynx in the scan?)",
+        nasal_side_name(o.side));
+  const NarisVoxels* mine = o.side == NasalSide::right ? nares.right : nares.left;
+  const std::uint8_t my_side = o.side == NasalSide::right ? 1 : 2;
+  auto keep = [&](std::size_t q) {
+    if (!nasal[q]) return false;
+    if (out.choana && behind(q, *out.choana)) return o.keep_nasopharynx;
+    return split.side.empty() || split.side[q] == my_side;
+  };
+  if (out.choana && !o.keep_nasopharynx)
+    out.outlet = fmt::format("{}={}", axis_letter, *out.choana);
+  return flood(g, mine->voxels, keep);
+}
+
 }  // namespace
 
 NasalSide parse_nasal_side(const std::string& text) {
@@ -447,94 +587,9 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
   std::vector<float> depth = squared_distance(frame, tissue, OutsideIs::nothing, o.threads);
   for (float& d : depth) d = std::sqrt(d);
 
-  // The nares: inner air facing the room air through an opening wider than a voxel (a rim of
-  // partial-volume voxels around a region of room air is not an opening).
-  // Lumen is at least kLumenDepth from tissue (on any grid: thin-slice CTs resolve the skin's
-  // partial-volume rim in more voxels, not in more millimetres).
-  const double min_opening = std::max(kLumenDepth, frame.spacing.maxCoeff());
-  std::vector<NarisVoxels> candidates = find_nares(frame, g, inner, room, depth, min_opening);
-  // The nostrils open downwards (and forwards): an opening that faces more to the front or the
-  // side than to the feet is the mouth, a de-identification mask or the skin, not a naris.
-  std::erase_if(candidates, [&](const NarisVoxels& c) {
-    return c.widest < min_opening || c.naris.area < 4.0 * min_opening * min_opening ||
-           c.naris.normal[2] > -0.5;
-  });
-  if (candidates.empty())
-    fail(
-        "no naris found: no air inside the body opens downwards to the room air wider than "
-        "{:.1f} mm (is the nose inside the scan?)",
-        min_opening);
-  std::sort(candidates.begin(), candidates.end(),
-            [](const auto& a, const auto& b) { return a.naris.area > b.naris.area; });
-  // Right and left: the widest opening on each side of the airway's midline (x, LPS: left +).
-  std::vector<std::size_t> all_naris;
-  for (const auto& c : candidates)
-    all_naris.insert(all_naris.end(), c.voxels.begin(), c.voxels.end());
-  const Mask reached = flood(g, all_naris, [&](std::size_t q) { return inner[q] != 0; });
-  double mid_x = 0.0;
-  {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    std::size_t count = 0;
-    for (std::size_t q = 0; q < n; ++q)
-      if (reached[q]) sum += Eigen::Vector3d(g.coord(q, 0), g.coord(q, 1), g.coord(q, 2)), ++count;
-    mid_x = frame.physical(sum / static_cast<double>(count))[0];
-  }
-  const NarisVoxels* right = nullptr;
-  const NarisVoxels* left = nullptr;
-  for (const auto& c : candidates) {
-    const NarisVoxels*& slot = c.naris.centre[0] < mid_x ? right : left;
-    if (!slot) slot = &c;
-  }
-  if (right && left) mid_x = 0.5 * (right->naris.centre[0] + left->naris.centre[0]);
-  if (o.side == NasalSide::right && !right)
-    fail("no right naris found (the openings found lie left of the midline x = {:.1f} mm)", mid_x);
-  if (o.side == NasalSide::left && !left)
-    fail("no left naris found (the openings found lie right of the midline x = {:.1f} mm)", mid_x);
-  std::vector<std::size_t> naris_voxels;
-  for (const NarisVoxels* c : {right, left})
-    if (c) naris_voxels.insert(naris_voxels.end(), c->voxels.begin(), c->voxels.end());
-  const Mask airway = flood(g, naris_voxels, [&](std::size_t q) { return inner[q] != 0; });
-
-  // Sinuses: wide places reached only through a way in narrower by the margin, except the
-  // nasopharynx (the lowest wide place near the midline, below the airway's mean level).
-  const std::vector<float> way_in = bottleneck(g, airway, depth, naris_voxels);
-  const std::vector<std::size_t> places = wide_places(g, airway, depth, kPlaceDynamics);
-  double mean_level = 0.0;
-  {
-    std::size_t count = 0;
-    for (std::size_t q = 0; q < n; ++q)
-      if (airway[q]) {
-        mean_level += frame.physical(Eigen::Vector3d(g.coord(q, 0), g.coord(q, 1), g.coord(q, 2)))
-                          .dot(Eigen::Vector3d::UnitZ());
-        ++count;
-      }
-    mean_level /= static_cast<double>(count);
-  }
-  auto position = [&](std::size_t q) {
-    return frame.physical(Eigen::Vector3d(g.coord(q, 0), g.coord(q, 1), g.coord(q, 2)));
-  };
-  std::optional<std::size_t> pharynx;
-  for (std::size_t p : places) {
-    const Eigen::Vector3d x = position(p);
-    if (depth[p] < kPharynxDepth || std::abs(x[0] - mid_x) > 15.0 || x[2] > mean_level) continue;
-    if (!pharynx || x[2] < position(*pharynx)[2]) pharynx = p;
-  }
-  double naris_level = 0.0, naris_area = 0.0;
-  for (const NarisVoxels* c : {right, left})
-    if (c) naris_level += c->naris.area * c->naris.centre[2], naris_area += c->naris.area;
-  naris_level /= naris_area;
-  std::vector<std::pair<std::size_t, std::uint8_t>> seeds;
-  for (std::size_t q : naris_voxels) seeds.emplace_back(q, 1);
-  for (std::size_t p : places) {
-    // High above the nares only ethmoid (and frontal, sphenoid) cells are wide: any narrowing
-    // on their way in makes them sinuses.
-    const double margin =
-        position(p)[2] - naris_level > o.ethmoid_height ? o.ethmoid_margin : o.sinus_margin;
-    const bool sinus = p != pharynx && depth[p] - way_in[p] >= margin;
-    seeds.emplace_back(p, sinus ? 2 : 1);
-    out.sinuses += sinus;
-  }
-  const Mask label = compete(g, airway, depth, seeds);
+  const Nares nares = choose_nares(frame, g, inner, room, depth, o.side);
+  const Mask airway = flood(g, nares.voxels, [&](std::size_t q) { return inner[q] != 0; });
+  const Mask label = separate_sinuses(frame, g, airway, depth, nares, o, out.sinuses);
   Mask nasal(n);
   std::size_t sinus_count = 0;
   for (std::size_t q = 0; q < n; ++q) {
@@ -543,73 +598,33 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
   }
   out.sinus_ml = static_cast<double>(sinus_count) * voxel_ml;
 
-  // The sides, separated by the septum down to the choana.
-  const int ap = axes.axis[1], ap_sign = axes.sign[1];
-  SideSplit split;
-  if (right && left) {
-    split =
-        split_sides(frame, g, nasal, depth, right->voxels, left->voxels, ap, ap_sign, min_opening);
-    out.choana = split.choana;
-  }
-  auto behind = [&](std::size_t q, int slice) {  // strictly posterior of `slice`
-    return ap_sign > 0 ? g.coord(q, ap) > slice : g.coord(q, ap) < slice;
-  };
-  const char axis_letter = static_cast<char>('i' + ap);
-  Mask result;
-  if (o.side == NasalSide::both) {
-    if (o.keep_nasopharynx || !out.choana) {
-      result = nasal;
-    } else {
-      // Both cavities end a little behind the choanae, where they have joined.
-      const int extra = static_cast<int>(std::ceil(5.0 / frame.spacing[ap]));
-      const int cut = std::clamp(*out.choana + ap_sign * extra, 0, g.n[ap] - 1);
-      result.assign(n, 0);
-      for (std::size_t q = 0; q < n; ++q) result[q] = nasal[q] && !behind(q, cut);
-      result = flood(g, naris_voxels, [&](std::size_t q) { return result[q] != 0; });
-      out.outlet = fmt::format("{}={}", axis_letter, cut);
-    }
-  } else {
-    const NarisVoxels* mine = o.side == NasalSide::right ? right : left;
-    const std::uint8_t my_side = o.side == NasalSide::right ? 1 : 2;
-    auto keep = [&](std::size_t q) {
-      if (!nasal[q]) return false;
-      if (!out.choana) return split.side.empty() || split.side[q] == my_side;
-      if (behind(q, *out.choana)) return o.keep_nasopharynx;
-      return split.side.empty() || split.side[q] == my_side;
-    };
-    result = flood(g, mine->voxels, keep);
-    if (right && left && !out.choana)
-      fail(
-          "the {} side cannot be separated: no choana found (the boundary between the sides "
-          "never runs through open air: is the nasopharynx in the scan?)",
-          nasal_side_name(o.side));
-    if (out.choana && !o.keep_nasopharynx)
-      out.outlet = fmt::format("{}={}", axis_letter, *out.choana);
-  }
+  Mask result = select_side(frame, g, nasal, depth, nares, o, axes, out);
+  // Air cut by the scan's border is closed there by a wall: no stray open patch for the mesher.
+  for (std::size_t q = 0; q < n; ++q)
+    for (int a = 0; a < 3; ++a)
+      if (g.coord(q, a) == 0 || g.coord(q, a) + 1 == g.n[a]) result[q] = 0;
+
   // The inlet: the plane of the nares' openings (area-weighted), across the vestibule.
   Eigen::Vector3d centre = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero();
   double area = 0.0;
-  for (const NarisVoxels* c : {right, left}) {
-    if (!c || (o.side == NasalSide::right && c != right) ||
-        (o.side == NasalSide::left && c != left))
+  for (const NarisVoxels* c : {nares.right, nares.left}) {
+    if (!c || (o.side == NasalSide::right && c != nares.right) ||
+        (o.side == NasalSide::left && c != nares.left))
       continue;
     Naris naris = c->naris;
-    naris.right = c == right;
+    naris.right = c == nares.right;
     out.nares.push_back(naris);
     centre += naris.area * naris.centre;
     normal += naris.area * naris.normal;
     area += naris.area;
   }
   out.inlet = plane_text(centre / area, normal.normalized());
-  // Air cut by the scan's border is closed there by a wall: no stray open patch for the mesher.
-  for (std::size_t q = 0; q < n; ++q)
-    for (int a = 0; a < 3; ++a)
-      if (g.coord(q, a) == 0 || g.coord(q, a) + 1 == g.n[a]) result[q] = 0;
+
   std::size_t kept = 0;
   for (auto v : result) kept += v;
   out.volume_ml = static_cast<double>(kept) * voxel_ml;
   out.regions.frame = frame;
-  out.regions.values.assign(n, static_cast<std::uint8_t>(AirwayRegion::tissue));
+  out.regions.values.resize(n);
   for (std::size_t q = 0; q < n; ++q) {
     AirwayRegion r = AirwayRegion::tissue;
     if (result[q])
