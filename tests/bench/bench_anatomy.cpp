@@ -2,6 +2,9 @@
 // against their expert labels, on each scan's own grid: Dice, volume ratio and the mean
 // symmetric surface distance for the right cavity (label 3) and for both cavities with the
 // nasopharynx (labels 3, 4, 5), with the time of each segmentation.
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +13,7 @@
 #include "mesh/image/distance_transform.h"
 #include "mesh/image/nasal_airway.h"
 #include "mesh/image/read_volume.h"
+#include "postproc/figures/canvas.h"
 
 using namespace naris;
 namespace fs = std::filesystem;
@@ -58,18 +62,66 @@ Score score(const ImageFrame& f, const std::vector<std::uint8_t>& a, const Volum
           static_cast<double>(na) / static_cast<double>(nb), sum / static_cast<double>(count)};
 }
 
+// Coronal slices of the CT with the naris mask and the expert's label over it: blue both, red
+// naris only, green the expert only (docs/results/anatomy.md).
+void draw_slices(const Volume<float>& ct, const std::vector<std::uint8_t>& mask,
+                 const Volume<float>& labels, float label, std::initializer_list<int> slices,
+                 const std::string& title, const fs::path& path) {
+  const auto& d = ct.frame.dims;
+  const double px = 4.0, pz = px * ct.frame.spacing[2] / ct.frame.spacing[0], gap = 16.0;
+  const double panel = d[0] * px, height = d[2] * pz;
+  figures::Canvas canvas(static_cast<int>(slices.size() * (panel + gap) + gap),
+                         static_cast<int>(height + 110));
+  cairo_t* cr = canvas.cr();
+  cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);  // voxels edge to edge, no seams
+  double x0 = gap;
+  for (int j : slices) {
+    for (int k = 0; k < d[2]; ++k)
+      for (int i = 0; i < d[0]; ++i) {
+        const std::size_t q = ct.frame.index(i, j, k);
+        const double g = std::clamp((ct.values[q] + 1000.0) / 1400.0, 0.0, 1.0);
+        const bool m = mask[q], l = labels.values[q] == label;
+        double c[3] = {g, g, g};
+        const double tint[3][3] = {{0.24, 0.51, 0.9}, {0.9, 0.16, 0.16}, {0.16, 0.78, 0.24}};
+        if (m || l) {
+          const double* t = tint[m && l ? 0 : m ? 1 : 2];
+          for (int a = 0; a < 3; ++a) c[a] = (g + 2.0 * t[a]) / 3.0;
+        }
+        cairo_set_source_rgb(cr, c[0], c[1], c[2]);
+        // The patient's right on the left of the page, superior up.
+        cairo_rectangle(cr, x0 + i * px, 40 + (d[2] - 1 - k) * pz, px, pz);
+        cairo_fill(cr);
+      }
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    canvas.text(x0 + 0.5 * panel, 30, fmt::format("j = {}", j), 14, 0.5, 1.0);
+    x0 += panel + gap;
+  }
+  cairo_set_antialias(cr, CAIRO_ANTIALIAS_DEFAULT);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  canvas.text(gap, height + 60, title, 13, 0.0, 0.5);
+  canvas.text(gap, height + 82,
+              "Blue: both; red: naris only; green: the expert only. Data: NasalSeg (Zhang et al., "
+              "2024), CC BY 4.0.",
+              12, 0.0, 0.5);
+  canvas.write_png(path);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  // --figure PATH: also draw P005's right cavity on two coronal slices.
+  fs::path figure;
+  if (argc > 2 && std::string(argv[1]) == "--figure") figure = argv[2], argc -= 2, argv += 2;
   const fs::path dir = argc > 1 ? fs::path(argv[1]) : fs::path(NARIS_SHARED_DATA) / "nasalseg";
   if (!fs::exists(dir)) {
     std::printf("skipping: %s is absent\n", dir.c_str());
     return 0;
   }
   std::printf("Data: NasalSeg (Zhang et al., 2024), CC BY 4.0; the scan's own grid\n\n");
-  std::printf("| case | threshold (HU) | right: Dice | volume ratio | surface distance (mm) | "
-              "time (s) | both + nasopharynx: Dice | volume ratio | surface distance (mm) | "
-              "time (s) | sinuses left out (mL) | choana (slice, expert) |\n");
+  std::printf(
+      "| case | threshold (HU) | right: Dice | volume ratio | surface distance (mm) | "
+      "time (s) | both + nasopharynx: Dice | volume ratio | surface distance (mm) | "
+      "time (s) | sinuses left out (mL) | choana (slice, expert) |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const char* name : {"P005", "P045", "P055"}) {
     const Volume<float> ct = read_volume(dir / (std::string(name) + "_img.nrrd"));
@@ -88,10 +140,15 @@ int main(int argc, char** argv) {
     const double t_both = clock.seconds();
     const Score r = score(ct.frame, right.mask.values, labels, {3});
     const Score b = score(ct.frame, both.mask.values, labels, {3, 4, 5});
-    std::printf("| %s | %.0f | %.3f | %.2f | %.2f | %.2f | %.3f | %.2f | %.2f | %.2f | %.1f | %d, %d |\n",
-                name, right.threshold, r.dice, r.ratio, r.surface_mm, t_right, b.dice, b.ratio,
-                b.surface_mm, t_both, both.sinus_ml, right.choana ? *right.choana : -1,
-                expert_choana);
+    if (!figure.empty() && std::string(name) == "P005")
+      draw_slices(ct, right.mask.values, labels, 3.0f, {70, 100},
+                  "NasalSeg P005, the right nasal cavity: naris segment --airway nasal against "
+                  "the expert's label 3",
+                  figure);
+    std::printf(
+        "| %s | %.0f | %.3f | %.2f | %.2f | %.2f | %.3f | %.2f | %.2f | %.2f | %.1f | %d, %d |\n",
+        name, right.threshold, r.dice, r.ratio, r.surface_mm, t_right, b.dice, b.ratio,
+        b.surface_mm, t_both, both.sinus_ml, right.choana ? *right.choana : -1, expert_choana);
   }
   std::printf("\npeak memory %.0f MB\n", static_cast<double>(peak_memory_bytes()) / 1e6);
   return 0;
