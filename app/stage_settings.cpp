@@ -38,7 +38,9 @@ SegmentSettings::SegmentSettings() {
   table.add("threshold", job.threshold, "HU threshold, or 'auto'");
   table.add("inside", inside, "the airway is 'below' or 'above' the threshold")
       .one_of({"below", "above"});
-  table.add("seed", job.seeds, "seed voxel i,j,k or point x,y,z mm in the airway; repeatable");
+  table.add("seed", job.seeds,
+            "seed voxel i,j,k or point x,y,z mm in the airway; repeatable (with airway nasal, "
+            "points the airway must hold)");
   table.add("all_components", all_components, "keep every component (default: the largest)");
   table.add("rotate", job.rotate,
             "rotate the volume first, AXIS:DEGREES about image axis i, j or k (e.g. i:30); "

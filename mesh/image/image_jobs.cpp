@@ -186,13 +186,43 @@ SegmentJobResult run_segment_job(const SegmentJob& job) {
          job.input.string(), r.threshold, info.min_value, info.max_value);
   if (job.airway == "nasal") {
     if (labelmap) fail("{}: --airway nasal needs a CT in HU, not a labelmap", job.input.string());
-    if (!job.seeds.empty()) fail("--airway nasal finds the nares itself: give no seed");
     if (inside != InsideRule::below) fail("--airway nasal: the airway is below the threshold");
     NasalAirwayOptions options;
     if (job.threshold != "auto") options.threshold = r.threshold;
     options.side = job.side;
     options.keep_nasopharynx = job.keep_nasopharynx;
     NasalAirway nasal = segment_nasal_airway(ct, options);
+    // Seeds are points the airway must hold: each one that does not says where it lies.
+    for (const auto& text : job.seeds) {
+      const Voxel v = parse_seed(text, ct.frame);
+      const std::size_t q = ct.frame.index(v[0], v[1], v[2]);
+      const char* where = nullptr;
+      switch (static_cast<AirwayRegion>(nasal.regions.values[q])) {
+        case AirwayRegion::airway:
+          break;
+        case AirwayRegion::tissue:
+        case AirwayRegion::masked:
+          where = "in tissue or bone";
+          break;
+        case AirwayRegion::sinus:
+          where = "in a paranasal sinus";
+          break;
+        case AirwayRegion::room:
+          where = "outside the body, in the room air";
+          break;
+        case AirwayRegion::excluded:
+          where =
+              "in the nasal airway but not in the part kept (the other side, or behind the "
+              "choana: see --side and --nasopharynx)";
+          break;
+        case AirwayRegion::enclosed:
+          where = "in air the nares do not reach";
+          break;
+      }
+      if (where)
+        fail("seed '{}' (voxel {},{},{}, {:.0f} HU) lies {}", text, v[0], v[1], v[2], ct.values[q],
+             where);
+    }
     r.threshold = nasal.threshold;
     std::size_t voxels = 0;
     for (auto v : nasal.mask.values) voxels += v;

@@ -85,8 +85,8 @@ PatientAxes patient_axes(const ImageFrame& f) {
 
 // De-identification masks (blanked eyes, faces): regions of exactly the image's minimum with
 // hard edges, which no scanner makes (real air blurs into tissue over a voxel). In each slice
-// across `axis`, a 4-connected region of the minimum whose edge is mostly denser than −200 HU
-// is tissue. Returns the count of voxels so marked in `tissue`.
+// across `axis`, a 4-connected region of the minimum that keeps off the slice's border and whose
+// edge is mostly denser than −200 HU is tissue. Returns the count of voxels so marked in `tissue`.
 std::size_t mark_masked_regions(const Volume<float>& ct, const VoxelGrid& g, int axis,
                                 Mask& tissue) {
   const float lowest = *std::min_element(ct.values.begin(), ct.values.end());
@@ -100,6 +100,7 @@ std::size_t mark_masked_regions(const Volume<float>& ct, const VoxelGrid& g, int
     stack.assign(1, s);
     seen[s] = 1;
     std::size_t hard = 0, soft = 0;
+    bool edge = false;
     while (!stack.empty()) {
       const std::size_t q = stack.back();
       stack.pop_back();
@@ -107,7 +108,10 @@ std::size_t mark_masked_regions(const Volume<float>& ct, const VoxelGrid& g, int
       for (int a : {a1, a2}) {
         const int c = g.coord(q, a);
         for (int d : {-1, 1}) {
-          if (c + d < 0 || c + d >= g.n[a]) continue;
+          if (c + d < 0 || c + d >= g.n[a]) {
+            edge = true;  // the scan's own border: room air or outside the field of view
+            continue;
+          }
           const std::size_t r = d < 0 ? q - g.stride[a] : q + g.stride[a];
           if (ct.values[r] == lowest) {
             if (!seen[r]) seen[r] = 1, stack.push_back(r);
@@ -117,7 +121,7 @@ std::size_t mark_masked_regions(const Volume<float>& ct, const VoxelGrid& g, int
         }
       }
     }
-    if (hard > soft && region.size() >= 16) {
+    if (!edge && hard > soft && region.size() >= 16) {
       for (std::size_t q : region) tissue[q] = 1;
       marked += region.size();
     }
