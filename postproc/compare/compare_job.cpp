@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "core/atomic_file.h"
@@ -241,23 +242,34 @@ CompareResult run_compare_job(const CompareJob& job) {
         tip = std::min(tip, axis.dot(x)), end = std::max(end, axis.dot(x));
       figures::Series series;
       series.rgb = figures::group_colour(static_cast<int>(i));
-      std::size_t smallest = 0;
+      // The minimum area among the sections the whole flow crosses (90 % of the inlet's flux):
+      // in front of an oblique naris a plane cuts the vestibule's mouth only.
+      const double inlet_flux = s.planes["inlet"]["flux_ml_s"].get<double>() * 1e-6;
+      std::optional<std::size_t> smallest;
       for (double d = 0.5 * job.profile_step; d < end - tip; d += job.profile_step) {
         const SectionPlane cut{(tip + d) * axis, axis, "", d, true};
-        double area = NAN;
+        double area = NAN, flux = 0.0;
         try {
-          area = cutter.cut(cut).whole.area;
+          const auto section = cutter.cut(cut);
+          area = section.whole.area, flux = section.whole.flux;
         } catch (const Error&) {  // a plane in a gap of the airway along the axis
         }
         series.x.push_back(d);
         series.y.push_back(area);
-        if (std::isfinite(area) && !(area >= series.y[smallest])) smallest = series.x.size() - 1;
+        if (std::isfinite(area) && std::abs(flux) >= 0.9 * inlet_flux &&
+            (!smallest || area < series.y[*smallest]))
+          smallest = series.x.size() - 1;
       }
       if (series.x.size() < 2)
         fail("{}: the airway is too short for a profile step of {} mm", s.name, job.profile_step);
-      series.markers = {smallest};
-      series.label = fmt::format("{} (min {:.0f} mm² at {:.0f} mm)", s.name, series.y[smallest],
-                                 series.x[smallest]);
+      if (!smallest)
+        fail(
+            "{}: no section along the axis carries the inlet's flux (a plane cuts the airway "
+            "twice?): no minimum area",
+            s.name);
+      series.markers = {*smallest};
+      series.label = fmt::format("{} (min {:.0f} mm² at {:.0f} mm)", s.name, series.y[*smallest],
+                                 series.x[*smallest]);
       profile.series.push_back(std::move(series));
     }
     progress.finish();
