@@ -86,6 +86,11 @@ MeshSettings::MeshSettings() {
   table.add("patch", job.regions,
             "carve a named patch out of the wall: name:box=x0,y0,z0,x1,y1,z1 or "
             "name:sphere=x,y,z,r (mm); repeatable");
+  table
+      .add("smooth", job.smooth,
+           "a labelmap's wall on a smooth surface: its signed distance smoothed by a Gaussian "
+           "this many voxels wide, every voxel kept on its side (0: the staircase)")
+      .range(0.0, 3.0);
   table.add("improve", job.improve, "the quality improvement of section 3.3");
   table
       .add("min_edge", job.improve_options.min_edge_fraction,

@@ -203,7 +203,8 @@ Mask room_air(const ImageFrame& frame, const VoxelGrid& g, const Mask& tissue, d
 struct NarisVoxels {
   Naris naris;
   std::vector<std::size_t> voxels;
-  double widest = 0.0;  // the largest distance to tissue among its voxels (mm)
+  std::vector<Eigen::Vector3d> faces;  // centres of the voxel faces shared with the room air
+  double widest = 0.0;                 // the largest distance to tissue among its voxels (mm)
 };
 
 std::vector<NarisVoxels> find_nares(const ImageFrame& frame, const VoxelGrid& g, const Mask& inner,
@@ -239,7 +240,8 @@ std::vector<NarisVoxels> find_nares(const ImageFrame& frame, const VoxelGrid& g,
         step[axis] = dir;
         const Eigen::Vector3d out_dir = (m * step).normalized();
         c.naris.area += face_area[axis];
-        weighted += face_area[axis] * frame.physical(ijk + 0.5 * step);
+        c.faces.push_back(frame.physical(ijk + 0.5 * step));
+        weighted += face_area[axis] * c.faces.back();
         normal += face_area[axis] * out_dir;
       });
       // 26-neighbours among the facing voxels.
@@ -611,10 +613,12 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
   // The inlet: the plane of the nares' openings (area-weighted), across the vestibule.
   Eigen::Vector3d centre = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero();
   double area = 0.0;
+  std::vector<const NarisVoxels*> used;
   for (const NarisVoxels* c : {nares.right, nares.left}) {
     if (!c || (o.side == NasalSide::right && c != nares.right) ||
         (o.side == NasalSide::left && c != nares.left))
       continue;
+    used.push_back(c);
     Naris naris = c->naris;
     naris.right = c == nares.right;
     out.nares.push_back(naris);
@@ -622,7 +626,17 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
     normal += naris.area * naris.normal;
     area += naris.area;
   }
-  out.inlet = plane_text(centre / area, normal.normalized());
+  centre /= area;
+  normal.normalize();
+  // The openings are caps that bulge into the vestibule where the room air reaches in (a wide
+  // nostril lets the closing's balls in): the plane goes in past the deepest tenth of their
+  // faces by kLumenDepth, where the vestibule is one whole section.
+  std::vector<double> depths;
+  for (const NarisVoxels* c : used)
+    for (const Eigen::Vector3d& f : c->faces) depths.push_back((f - centre).dot(normal));
+  const auto tenth = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 10);
+  std::nth_element(depths.begin(), tenth, depths.end());
+  out.inlet = plane_text(centre + (*tenth - kLumenDepth) * normal, normal);
 
   std::size_t kept = 0;
   for (auto v : result) kept += v;

@@ -13,6 +13,7 @@
 #include "core/log.h"
 #include "core/units.h"
 #include "mesh/image/image_jobs.h"
+#include "mesh/image/smooth_label.h"
 #include "mesh/io/mesh_h5.h"
 #include "mesh/io/write_gmsh.h"
 #include "mesh/io/write_vtk.h"
@@ -123,6 +124,17 @@ mve::VolumeField make_field(Volume<float>& volume, const MeshJob& job, MeshJobRe
         job.input.string(), mode == InsideRule::label ? "label" : "threshold", level);
   r.level = level;
   r.rule = mode;
+  if (job.smooth > 0.0) {
+    if (mode != InsideRule::label)
+      fail("--smooth is for labelmaps: a CT or a scalar field has its own smooth level");
+    Volume<std::uint8_t> mask;
+    mask.frame = volume.frame;
+    mask.values.resize(volume.values.size());
+    for (std::size_t q = 0; q < volume.values.size(); ++q)
+      mask.values[q] = is_inside(mode, volume.values[q], level);
+    volume = smooth_label_field(mask, {.sigma = job.smooth, .threads = job.threads});
+    return mve::VolumeField(volume, InsideRule::above, 0.0);
+  }
   return mve::VolumeField(volume, mode, level);
 }
 

@@ -23,6 +23,9 @@ struct MeshJob {
   // Inside is one of these labels: "3", "3,5" (a union), or segment names ("right cavity").
   std::optional<std::string> label;
   InsideRule inside = InsideRule::below;  // with a threshold: its side (below or above)
+  // A labelmap's wall on a smooth surface instead of the staircase (smooth_label.h), with
+  // this Gaussian width in voxels (0: off).
+  double smooth = 0.0;
   std::optional<std::string> inlet, outlet;
   std::vector<std::string> regions;  // name:box=... or name:sphere=...
   bool keep_largest = true;

@@ -1211,6 +1211,14 @@ TEST_F(Cli, LabelsUnionsNamesAndLabelMapInterpolation) {
   expect_clean_failure(naris("mesh " + in.string() + " --label 3,4 " + out()),
                        "no voxel has label 4 (labels present: 0, 3 (right half), 5 (left half))");
   expect_clean_failure(naris("mesh " + in.string() + " --label nose " + out()), "no label 'nose'");
+  // The union's wall on a smooth surface: the same object, a little less volume than the
+  // chamfered staircase; a threshold field has no staircase to smooth.
+  const fs::path smooth = dir_ / "smooth";
+  r = naris("mesh " + in.string() + " --label 3,5 --smooth 1 -o " + (smooth / "mesh.h5").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NEAR(volume(smooth), volume(both), 0.1 * volume(both));
+  expect_clean_failure(naris("mesh " + in.string() + " --threshold 2 --smooth 1 " + out()),
+                       "--smooth is for labelmaps");
   const fs::path fine = dir_ / "fine.nrrd";
   r = naris("interpolate " + in.string() + " --insert 1 -o " + fine.string());
   ASSERT_EQ(r.status, 0) << r.err;
