@@ -4,7 +4,6 @@
 #include <array>
 #include <atomic>
 #include <cmath>
-#include <thread>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -42,6 +41,29 @@ void for_each_in_slice(const std::array<int, 3>& dims, int axis, int index, F&& 
     }
 }
 
+// The volume with k new slices between each pair along `axis`, zero-filled.
+Volume<float> interpolated_grid(const Volume<float>& v, int axis, int k) {
+  if (axis < 0 || axis > 2) fail("slice axis must be 0, 1 or 2 (i, j or k)");
+  if (k < 0) fail("the number of slices to insert must not be negative");
+  const int n = v.dims()[axis];
+  if (n < 2) fail("a volume with a single slice along axis {} cannot be interpolated", axis);
+  Volume<float> out;
+  out.frame = v.frame;
+  out.frame.dims[axis] = (n - 1) * (k + 1) + 1;
+  out.frame.spacing[axis] /= (k + 1);
+  out.values.assign(out.frame.voxel_count(), 0.0f);
+  return out;
+}
+
+// pair(p) for every pair of consecutive slices p, p + 1, shared among `threads` threads.
+template <class F>
+void for_each_slice_pair(int pairs, int threads, F&& pair) {
+  std::atomic<int> next{0};
+  run_threads(thread_count(threads), [&](unsigned, unsigned) {
+    for (int p; (p = next++) < pairs;) pair(p);
+  });
+}
+
 }  // namespace
 
 Image2D slice_across(const Volume<float>& v, int axis, int index) {
@@ -69,99 +91,71 @@ bool is_label_map(const Volume<float>& v) {
 }
 
 Volume<float> interpolate_label_map(const Volume<float>& v, int axis, int k, int threads) {
-  if (axis < 0 || axis > 2) fail("slice axis must be 0, 1 or 2 (i, j or k)");
-  if (k < 0) fail("the number of slices to insert must not be negative");
+  Volume<float> out = interpolated_grid(v, axis, k);
   const int n = v.dims()[axis];
-  if (n < 2) fail("a volume with a single slice along axis {} cannot be interpolated", axis);
   std::array<bool, 256> seen{};
   for (float x : v.values) seen[static_cast<std::size_t>(x)] = true;
   std::vector<double> labels;
   for (int l = 1; l < 256; ++l)
     if (seen[static_cast<std::size_t>(l)]) labels.push_back(l);
-  Volume<float> out;
-  out.frame = v.frame;
-  out.frame.dims[axis] = (n - 1) * (k + 1) + 1;
-  out.frame.spacing[axis] /= (k + 1);
-  out.values.assign(out.frame.voxel_count(), 0.0f);
   auto mask_of = [](const Image2D& im, double label) {
     Image2D m = im;
     for (double& x : m.v) x = x == label ? 1.0 : 0.0;
     return m;
   };
-  std::atomic<int> next{0};
-  auto worker = [&] {
+  for_each_slice_pair(n - 1, threads, [&](int p) {
     std::vector<Image2D> da(labels.size()), db(labels.size());
-    for (int p; (p = next++) < n - 1;) {
-      const Image2D a = slice_across(v, axis, p), b = slice_across(v, axis, p + 1);
-      set_slice_across(out, axis, p * (k + 1), a);
-      if (p + 1 == n - 1) set_slice_across(out, axis, (p + 1) * (k + 1), b);
-      if (k == 0) continue;
-      for (std::size_t l = 0; l < labels.size(); ++l) {
-        da[l] = signed_distance(mask_of(a, labels[l]));
-        db[l] = signed_distance(mask_of(b, labels[l]));
-      }
-      for (int q = 1; q <= k; ++q) {
-        const double s = static_cast<double>(q) / (k + 1);
-        Image2D im{a.width, a.height, std::vector<double>(a.v.size(), 0.0)};
-        for (std::size_t px = 0; px < im.v.size(); ++px) {
-          double best = 0.0;
-          for (std::size_t l = 0; l < labels.size(); ++l) {
-            const double d = (1 - s) * da[l].v[px] + s * db[l].v[px];
-            if (d > best) best = d, im.v[px] = labels[l];
-          }
-        }
-        set_slice_across(out, axis, p * (k + 1) + q, im);
-      }
+    const Image2D a = slice_across(v, axis, p), b = slice_across(v, axis, p + 1);
+    set_slice_across(out, axis, p * (k + 1), a);
+    if (p + 1 == n - 1) set_slice_across(out, axis, (p + 1) * (k + 1), b);
+    if (k == 0) return;
+    for (std::size_t l = 0; l < labels.size(); ++l) {
+      da[l] = signed_distance(mask_of(a, labels[l]));
+      db[l] = signed_distance(mask_of(b, labels[l]));
     }
-  };
-  const unsigned count = thread_count(threads);
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < count; ++t) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
+    for (int q = 1; q <= k; ++q) {
+      const double s = static_cast<double>(q) / (k + 1);
+      Image2D im{a.width, a.height, std::vector<double>(a.v.size(), 0.0)};
+      for (std::size_t px = 0; px < im.v.size(); ++px) {
+        double best = 0.0;
+        for (std::size_t l = 0; l < labels.size(); ++l) {
+          const double d = (1 - s) * da[l].v[px] + s * db[l].v[px];
+          if (d > best) best = d, im.v[px] = labels[l];
+        }
+      }
+      set_slice_across(out, axis, p * (k + 1) + q, im);
+    }
+  });
   return out;
 }
 
 Volume<float> interpolate_slices(const Volume<float>& v, int axis, int k, SliceMethod method,
                                  const HsrOptions& hsr, int threads) {
-  if (axis < 0 || axis > 2) fail("slice axis must be 0, 1 or 2 (i, j or k)");
-  if (k < 0) fail("the number of slices to insert must not be negative");
+  Volume<float> out = interpolated_grid(v, axis, k);
   const int n = v.dims()[axis];
-  if (n < 2) fail("a volume with a single slice along axis {} cannot be interpolated", axis);
   const bool mask = is_binary(v);
-  Volume<float> out;
-  out.frame = v.frame;
-  out.frame.dims[axis] = (n - 1) * (k + 1) + 1;
-  out.frame.spacing[axis] /= (k + 1);
-  out.values.assign(out.frame.voxel_count(), 0.0f);
-  std::atomic<int> next{0};
-  auto worker = [&] {
-    for (int p; (p = next++) < n - 1;) {
-      const Image2D a = slice_across(v, axis, p), b = slice_across(v, axis, p + 1);
-      set_slice_across(out, axis, p * (k + 1), a);
-      if (p + 1 == n - 1) set_slice_across(out, axis, (p + 1) * (k + 1), b);
-      // I2 is the lower slice (s = 0), I1 the upper (s = 1).
-      Displacement d;
-      if (method == SliceMethod::hsr && k > 0) d = register_hsr(b, a, hsr);
-      Image2D da, db;  // signed distance maps, once per pair
-      if (method == SliceMethod::shape && k > 0) {
-        da = signed_distance(a);
-        db = signed_distance(b);
-      }
-      for (int q = 1; q <= k; ++q) {
-        const double s = static_cast<double>(q) / (k + 1);
-        Image2D im = method == SliceMethod::hsr      ? interpolate_hsr(b, a, d, s)
-                     : method == SliceMethod::linear ? interpolate_linear(b, a, s)
-                                                     : interpolate_signed_distance(db, da, s);
-        if (mask && method != SliceMethod::shape)
-          for (double& x : im.v) x = x > 0.5 ? 1.0 : 0.0;
-        set_slice_across(out, axis, p * (k + 1) + q, im);
-      }
+  for_each_slice_pair(n - 1, threads, [&](int p) {
+    const Image2D a = slice_across(v, axis, p), b = slice_across(v, axis, p + 1);
+    set_slice_across(out, axis, p * (k + 1), a);
+    if (p + 1 == n - 1) set_slice_across(out, axis, (p + 1) * (k + 1), b);
+    // I2 is the lower slice (s = 0), I1 the upper (s = 1).
+    Displacement d;
+    if (method == SliceMethod::hsr && k > 0) d = register_hsr(b, a, hsr);
+    Image2D da, db;  // signed distance maps, once per pair
+    if (method == SliceMethod::shape && k > 0) {
+      da = signed_distance(a);
+      db = signed_distance(b);
     }
-  };
-  const unsigned count = thread_count(threads);
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < count; ++t) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
+    for (int q = 1; q <= k; ++q) {
+      const double s = static_cast<double>(q) / (k + 1);
+      Image2D im = method == SliceMethod::hsr      ? interpolate_hsr(b, a, d, s)
+                   : method == SliceMethod::linear ? interpolate_linear(b, a, s)
+                                                   : interpolate_signed_distance(db, da, s);
+      if (mask && method != SliceMethod::shape)
+        for (double& x : im.v) x = x > 0.5 ? 1.0 : 0.0;
+      set_slice_across(out, axis, p * (k + 1) + q, im);
+    }
+  });
   return out;
 }
 

@@ -303,46 +303,30 @@ std::vector<std::size_t> wide_places(const VoxelGrid& g, const Mask& airway,
   return places;
 }
 
-// For every airway voxel, the widest bottleneck of a path to it from the seeds: the largest,
-// over paths, of the smallest distance to tissue along the path.
-std::vector<float> bottleneck(const VoxelGrid& g, const Mask& airway,
-                              const std::vector<float>& depth,
-                              const std::vector<std::size_t>& seeds) {
-  std::vector<float> b(g.size(), -1.0f);
+// Seeded watershed on the distance to tissue: every airway voxel gets the widest bottleneck of a
+// path to it from the seeds (the largest, over paths, of the smallest distance along the path)
+// and the label of the seed it is so reached from (ties: the first reached).
+struct WidestPaths {
+  std::vector<float> bottleneck;
+  Mask label;
+};
+WidestPaths widest_paths(const VoxelGrid& g, const Mask& airway, const std::vector<float>& depth,
+                         const std::vector<std::pair<std::size_t, std::uint8_t>>& seeds) {
+  WidestPaths w{std::vector<float>(g.size(), -1.0f), Mask(g.size(), 0)};
   std::priority_queue<std::pair<float, std::size_t>> queue;
-  for (std::size_t s : seeds) b[s] = depth[s], queue.emplace(depth[s], s);
+  for (const auto& [s, l] : seeds)
+    w.label[s] = l, w.bottleneck[s] = depth[s], queue.emplace(depth[s], s);
   while (!queue.empty()) {
     const auto [value, q] = queue.top();
     queue.pop();
-    if (value < b[q]) continue;
+    if (value < w.bottleneck[q]) continue;
     g.neighbours(q, [&](std::size_t r, int, int) {
       if (!airway[r]) return;
       const float v = std::min(value, depth[r]);
-      if (v > b[r]) b[r] = v, queue.emplace(v, r);
+      if (v > w.bottleneck[r]) w.bottleneck[r] = v, w.label[r] = w.label[q], queue.emplace(v, r);
     });
   }
-  return b;
-}
-
-// Seeded watershed: every airway voxel joins the seed it is reached from through the widest
-// bottleneck (ties: the first reached). Labels: 1 nasal, 2 sinus.
-Mask compete(const VoxelGrid& g, const Mask& airway, const std::vector<float>& depth,
-             const std::vector<std::pair<std::size_t, std::uint8_t>>& seeds) {
-  Mask label(g.size(), 0);
-  std::vector<float> b(g.size(), -1.0f);
-  std::priority_queue<std::pair<float, std::size_t>> queue;
-  for (const auto& [s, l] : seeds) label[s] = l, b[s] = depth[s], queue.emplace(depth[s], s);
-  while (!queue.empty()) {
-    const auto [value, q] = queue.top();
-    queue.pop();
-    if (value < b[q]) continue;
-    g.neighbours(q, [&](std::size_t r, int, int) {
-      if (!airway[r]) return;
-      const float v = std::min(value, depth[r]);
-      if (v > b[r]) b[r] = v, label[r] = label[q], queue.emplace(v, r);
-    });
-  }
-  return label;
+  return w;
 }
 
 // The two sides: each airway voxel goes to the naris it is nearest to along the airway (a
@@ -476,7 +460,9 @@ Nares choose_nares(const ImageFrame& frame, const VoxelGrid& g, const Mask& inne
 Mask separate_sinuses(const ImageFrame& frame, const VoxelGrid& g, const Mask& airway,
                       const std::vector<float>& depth, const Nares& nares,
                       const NasalAirwayOptions& o, std::size_t& sinuses) {
-  const std::vector<float> way_in = bottleneck(g, airway, depth, nares.voxels);
+  std::vector<std::pair<std::size_t, std::uint8_t>> seeds;
+  for (std::size_t q : nares.voxels) seeds.emplace_back(q, 1);
+  const std::vector<float> way_in = widest_paths(g, airway, depth, seeds).bottleneck;
   const std::vector<std::size_t> places = wide_places(g, airway, depth, kPlaceDynamics);
   auto position = [&](std::size_t q) { return frame.physical(g.ijk(q)); };
   double mean_level = 0.0;
@@ -491,8 +477,6 @@ Mask separate_sinuses(const ImageFrame& frame, const VoxelGrid& g, const Mask& a
       continue;
     if (!pharynx || x[2] < position(*pharynx)[2]) pharynx = p;
   }
-  std::vector<std::pair<std::size_t, std::uint8_t>> seeds;
-  for (std::size_t q : nares.voxels) seeds.emplace_back(q, 1);
   sinuses = 0;
   for (std::size_t p : places) {
     const double margin =
@@ -501,7 +485,7 @@ Mask separate_sinuses(const ImageFrame& frame, const VoxelGrid& g, const Mask& a
     seeds.emplace_back(p, sinus ? 2 : 1);
     sinuses += sinus;
   }
-  return compete(g, airway, depth, seeds);
+  return widest_paths(g, airway, depth, seeds).label;
 }
 
 // The side or sides asked for, with the choana (out.choana) and the outlet plane (out.outlet).
