@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/parallel.h"
+#include "mesh/image/grid_lines.h"
 
 namespace naris {
 namespace {
@@ -52,34 +52,17 @@ void transform_line(std::span<float> f, double s, bool outside_target, std::vect
 
 std::vector<float> squared_distance(const ImageFrame& frame, std::span<const std::uint8_t> target,
                                     OutsideIs outside, int threads) {
-  const auto& n = frame.dims;
   std::vector<float> dist(target.size());
   for (std::size_t q = 0; q < target.size(); ++q) dist[q] = target[q] ? 0.0f : kInf;
   const bool outside_target = outside == OutsideIs::target;
-  const unsigned workers = thread_count(threads);
   for (int axis = 0; axis < 3; ++axis) {
-    const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-    const std::size_t stride = axis == 0   ? 1
-                               : axis == 1 ? static_cast<std::size_t>(n[0])
-                                           : static_cast<std::size_t>(n[0]) * n[1];
-    const std::size_t lines = static_cast<std::size_t>(n[a1]) * n[a2];
-    run_threads(workers, [&](unsigned t, unsigned count) {
-      const auto [begin, end] = share(lines, t, count);
-      const int len = n[axis];
-      std::vector<float> line(static_cast<std::size_t>(len));
-      std::vector<double> d(static_cast<std::size_t>(len));
-      std::vector<int> v(static_cast<std::size_t>(len) + 3);
-      std::vector<double> z(static_cast<std::size_t>(len) + 3);
-      for (std::size_t l = begin; l < end; ++l) {
-        std::array<int, 3> ijk{};
-        ijk[axis] = 0;
-        ijk[a1] = static_cast<int>(l % static_cast<std::size_t>(n[a1]));
-        ijk[a2] = static_cast<int>(l / static_cast<std::size_t>(n[a1]));
-        const std::size_t first = frame.index(ijk[0], ijk[1], ijk[2]);
-        for (int x = 0; x < len; ++x) line[x] = dist[first + stride * x];
-        transform_line(line, frame.spacing[axis], outside_target, d, v, z);
-        for (int x = 0; x < len; ++x) dist[first + stride * x] = line[x];
-      }
+    const std::size_t len = static_cast<std::size_t>(frame.dims[axis]);
+    const double s = frame.spacing[axis];
+    transform_lines(frame, dist, axis, threads, [&] {
+      return [=, d = std::vector<double>(len), v = std::vector<int>(len + 3),
+              z = std::vector<double>(len + 3)](std::span<float> line) mutable {
+        transform_line(line, s, outside_target, d, v, z);
+      };
     });
   }
   return dist;

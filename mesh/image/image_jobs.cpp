@@ -93,17 +93,16 @@ InterpolateJobResult run_interpolate_job(const InterpolateJob& job) {
   r.inserted =
       job.insert ? *job.insert : std::max(0, static_cast<int>(std::lround(h / target)) - 1);
   r.mask = is_binary(v);
-  if (!r.mask && is_label_map(v)) {
-    // Labels are not intensities: HSR or a cross-fade would invent labels between two.
-    std::array<bool, 256> seen{};
-    for (float x : v.values) seen[static_cast<std::size_t>(x)] = true;
-    r.labels = static_cast<int>(std::count(seen.begin() + 1, seen.end(), true));
-    const Volume<float> out = interpolate_label_map(v, r.axis, r.inserted, job.threads);
+  // Labels are not intensities: HSR or a cross-fade would invent labels between two.
+  if (const std::vector<float> labels = r.mask ? std::vector<float>{} : map_labels(v);
+      !labels.empty()) {
+    r.labels = static_cast<int>(labels.size());
+    const Volume<float> out = interpolate_label_map(v, labels, r.axis, r.inserted, job.threads);
     r.after = out.frame;
-    Volume<std::uint8_t> labels;
-    labels.frame = out.frame;
-    labels.values.assign(out.values.begin(), out.values.end());
-    write_labelmap_nrrd(labels, job.output);
+    Volume<std::uint8_t> map;
+    map.frame = out.frame;
+    map.values.assign(out.values.begin(), out.values.end());
+    write_labelmap_nrrd(map, job.output);
     r.seconds = clock.seconds();
     return r;
   }
@@ -138,6 +137,86 @@ std::string format_interpolate_summary(const InterpolateJob& job, const Interpol
       dims_text(r.before), dims_text(r.after), spacing_text(r.before), spacing_text(r.after),
       r.inserted, "ijk"[r.axis], r.seconds, job.output.string());
 }
+
+namespace {
+
+// Where a seed the nasal airway does not hold lies (null: in the airway).
+const char* where_it_lies(AirwayRegion region) {
+  switch (region) {
+    case AirwayRegion::airway:
+      return nullptr;
+    case AirwayRegion::tissue:
+    case AirwayRegion::masked:
+      return "in tissue or bone";
+    case AirwayRegion::sinus:
+      return "in a paranasal sinus";
+    case AirwayRegion::room:
+      return "outside the body, in the room air";
+    case AirwayRegion::excluded:
+      return "in the nasal airway but not in the part kept (the other side, or behind the "
+             "choana: see --side and --nasopharynx)";
+    case AirwayRegion::enclosed:
+      return "in air the nares do not reach";
+  }
+  return nullptr;
+}
+
+// The airway's sidecar: what the segmentation found, and the planes for the mesher's "auto".
+Json nasal_sidecar(const SegmentJob& job, const NasalAirway& nasal, const fs::path& regions) {
+  Json sidecar{{"airway", "nasal"},
+               {"side", nasal_side_name(job.side)},
+               {"nasopharynx", job.keep_nasopharynx ? "keep" : "cut"},
+               {"threshold_hu", significant(nasal.threshold, 5)},
+               {"volume_ml", significant(nasal.volume_ml, 5)},
+               {"sinus_ml", significant(nasal.sinus_ml, 5)},
+               {"sinuses", nasal.sinuses},
+               {"room_ml", significant(nasal.room_ml, 5)},
+               {"masked_voxels", nasal.masked_voxels},
+               {"inlet", nasal.inlet},
+               {"outlet", nasal.outlet.empty() ? Json() : Json(nasal.outlet)},
+               {"choana_slice", nasal.choana ? Json(*nasal.choana) : Json()},
+               {"ap_axis", std::string(1, static_cast<char>('i' + nasal.ap_axis))}};
+  Json& nares = sidecar["nares"] = Json::array();
+  for (const Naris& n : nasal.nares)
+    nares.push_back({{"side", n.right ? "right" : "left"},
+                     {"opening_mm2", significant(n.area, 5)},
+                     {"centre_mm", {n.centre[0], n.centre[1], n.centre[2]}},
+                     {"normal", {n.normal[0], n.normal[1], n.normal[2]}}});
+  sidecar["regions"] = regions.filename().string();
+  return sidecar;
+}
+
+// segment --airway nasal: the airway, checked against the seeds, with its sidecar and regions.
+void run_nasal_airway(const SegmentJob& job, const Volume<float>& ct, SegmentJobResult& r) {
+  NasalAirwayOptions options;
+  if (job.threshold != "auto") options.threshold = r.threshold;
+  options.side = job.side;
+  options.keep_nasopharynx = job.keep_nasopharynx;
+  NasalAirway nasal = segment_nasal_airway(ct, options);
+  for (const auto& text : job.seeds) {
+    const Voxel v = parse_seed(text, ct.frame);
+    const std::size_t q = ct.frame.index(v[0], v[1], v[2]);
+    if (const char* where = where_it_lies(static_cast<AirwayRegion>(nasal.regions.values[q])))
+      fail("seed '{}' (voxel {},{},{}, {:.0f} HU) lies {}", text, v[0], v[1], v[2], ct.values[q],
+           where);
+  }
+  r.threshold = nasal.threshold;
+  r.components = {
+      1,
+      static_cast<std::size_t>(std::count(nasal.mask.values.begin(), nasal.mask.values.end(), 1)),
+      0};
+  r.frame = nasal.mask.frame;
+  r.inside = InsideRule::below;
+  const fs::path regions = segmentation_regions(job.output);
+  write_labelmap_nrrd(nasal.mask, job.output);
+  write_labelmap_nrrd(nasal.regions, regions);
+  write_json_file(segmentation_sidecar(job.output), nasal_sidecar(job, nasal, regions));
+  nasal.mask = {};
+  nasal.regions = {};
+  r.nasal = std::move(nasal);
+}
+
+}  // namespace
 
 SegmentJobResult run_segment_job(const SegmentJob& job) {
   ensure_writable_folder(fs::absolute(job.output).parent_path());
@@ -187,75 +266,7 @@ SegmentJobResult run_segment_job(const SegmentJob& job) {
   if (job.airway == "nasal") {
     if (labelmap) fail("{}: --airway nasal needs a CT in HU, not a labelmap", job.input.string());
     if (inside != InsideRule::below) fail("--airway nasal: the airway is below the threshold");
-    NasalAirwayOptions options;
-    if (job.threshold != "auto") options.threshold = r.threshold;
-    options.side = job.side;
-    options.keep_nasopharynx = job.keep_nasopharynx;
-    NasalAirway nasal = segment_nasal_airway(ct, options);
-    // Seeds are points the airway must hold: each one that does not says where it lies.
-    for (const auto& text : job.seeds) {
-      const Voxel v = parse_seed(text, ct.frame);
-      const std::size_t q = ct.frame.index(v[0], v[1], v[2]);
-      const char* where = nullptr;
-      switch (static_cast<AirwayRegion>(nasal.regions.values[q])) {
-        case AirwayRegion::airway:
-          break;
-        case AirwayRegion::tissue:
-        case AirwayRegion::masked:
-          where = "in tissue or bone";
-          break;
-        case AirwayRegion::sinus:
-          where = "in a paranasal sinus";
-          break;
-        case AirwayRegion::room:
-          where = "outside the body, in the room air";
-          break;
-        case AirwayRegion::excluded:
-          where =
-              "in the nasal airway but not in the part kept (the other side, or behind the "
-              "choana: see --side and --nasopharynx)";
-          break;
-        case AirwayRegion::enclosed:
-          where = "in air the nares do not reach";
-          break;
-      }
-      if (where)
-        fail("seed '{}' (voxel {},{},{}, {:.0f} HU) lies {}", text, v[0], v[1], v[2], ct.values[q],
-             where);
-    }
-    r.threshold = nasal.threshold;
-    std::size_t voxels = 0;
-    for (auto v : nasal.mask.values) voxels += v;
-    r.components = {1, voxels, 0};
-    r.frame = nasal.mask.frame;
-    r.inside = inside;
-    write_labelmap_nrrd(nasal.mask, job.output);
-    Json sidecar{{"airway", "nasal"},
-                 {"side", nasal_side_name(job.side)},
-                 {"nasopharynx", job.keep_nasopharynx ? "keep" : "cut"},
-                 {"threshold_hu", significant(nasal.threshold, 5)},
-                 {"volume_ml", significant(nasal.volume_ml, 5)},
-                 {"sinus_ml", significant(nasal.sinus_ml, 5)},
-                 {"sinuses", nasal.sinuses},
-                 {"room_ml", significant(nasal.room_ml, 5)},
-                 {"masked_voxels", nasal.masked_voxels},
-                 {"inlet", nasal.inlet},
-                 {"outlet", nasal.outlet.empty() ? Json() : Json(nasal.outlet)},
-                 {"choana_slice", nasal.choana ? Json(*nasal.choana) : Json()},
-                 {"ap_axis", std::string(1, static_cast<char>('i' + nasal.ap_axis))}};
-    Json& nares = sidecar["nares"] = Json::array();
-    for (const Naris& n : nasal.nares)
-      nares.push_back({{"side", n.right ? "right" : "left"},
-                       {"opening_mm2", significant(n.area, 5)},
-                       {"centre_mm", {n.centre[0], n.centre[1], n.centre[2]}},
-                       {"normal", {n.normal[0], n.normal[1], n.normal[2]}}});
-    const fs::path regions = segmentation_regions(job.output);
-    sidecar["regions"] = regions.filename().string();
-    write_labelmap_nrrd(nasal.regions, regions);
-    write_json_file(segmentation_sidecar(job.output), sidecar);
-    nasal.mask = {};
-    nasal.regions = {};
-    r.nasal = std::move(nasal);
+    run_nasal_airway(job, ct, r);
     r.seconds = clock.seconds();
     return r;
   }

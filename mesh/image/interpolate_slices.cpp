@@ -81,23 +81,23 @@ void set_slice_across(Volume<float>& v, int axis, int index, const Image2D& im) 
   });
 }
 
-bool is_label_map(const Volume<float>& v) {
+std::vector<float> map_labels(const Volume<float>& v) {
   std::array<bool, 256> seen{};
   for (float x : v.values) {
-    if (!(x >= 0.0f && x <= 255.0f) || x != std::floor(x)) return false;
+    if (!(x >= 0.0f && x <= 255.0f) || x != std::floor(x)) return {};
     seen[static_cast<std::size_t>(x)] = true;
   }
-  return std::count(seen.begin() + 1, seen.end(), true) > 1;
+  std::vector<float> labels;
+  for (int l = 1; l < 256; ++l)
+    if (seen[static_cast<std::size_t>(l)]) labels.push_back(static_cast<float>(l));
+  if (labels.size() < 2) labels.clear();
+  return labels;
 }
 
-Volume<float> interpolate_label_map(const Volume<float>& v, int axis, int k, int threads) {
+Volume<float> interpolate_label_map(const Volume<float>& v, const std::vector<float>& labels,
+                                    int axis, int k, int threads) {
   Volume<float> out = interpolated_grid(v, axis, k);
   const int n = v.dims()[axis];
-  std::array<bool, 256> seen{};
-  for (float x : v.values) seen[static_cast<std::size_t>(x)] = true;
-  std::vector<double> labels;
-  for (int l = 1; l < 256; ++l)
-    if (seen[static_cast<std::size_t>(l)]) labels.push_back(l);
   auto mask_of = [](const Image2D& im, double label) {
     Image2D m = im;
     for (double& x : m.v) x = x == label ? 1.0 : 0.0;

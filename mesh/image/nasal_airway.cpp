@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <queue>
 
 #include "core/error.h"
@@ -15,11 +14,20 @@
 namespace naris {
 namespace {
 
-constexpr double kLumenDepth = 1.5;     // mm
-constexpr double kPlaceDynamics = 1.0;  // mm: a wide place stands this far above its saddle
-constexpr double kPharynxDepth = 5.0;   // mm: the nasopharynx is at least this wide
+constexpr double kLumenDepth = 1.5;          // mm
+constexpr double kPlaceDynamics = 1.0;       // mm: a wide place stands this far above its saddle
+constexpr double kPharynxDepth = 5.0;        // mm: the nasopharynx is at least this wide ...
+constexpr double kPharynxOffMidline = 15.0;  // mm: ... and this near the midline
+constexpr double kChoanaSearch = 10.0;       // mm behind the nares: where the choana search starts
+constexpr double kBehindChoanae = 5.0;       // mm: both cavities end this far behind the choanae
 
 using Mask = std::vector<std::uint8_t>;
+
+// Lumen lies at least this far from tissue (mm): kLumenDepth, or a voxel on a coarse grid
+// (thin-slice CTs resolve the skin's partial-volume rim in more voxels, not more millimetres).
+double lumen_depth(const ImageFrame& frame) {
+  return std::max(kLumenDepth, frame.spacing.maxCoeff());
+}
 
 // Index arithmetic and 6-neighbourhoods on one grid.
 struct VoxelGrid {
@@ -174,29 +182,25 @@ Mask room_air(const ImageFrame& frame, const VoxelGrid& g, const Mask& tissue, d
       }
     }
   // The largest 6-connected open region holding a seed.
-  Mask room(n, 0), label(n, 0);
-  std::size_t best = 0;
-  std::vector<std::size_t> members;
+  Mask seen(n, 0);
+  std::size_t best = 0, best_seed = 0;
+  std::vector<std::size_t> stack;
   for (std::size_t s : seeds) {
-    if (label[s]) continue;
-    members.clear();
-    std::vector<std::size_t> stack{s};
-    label[s] = 1;
+    if (seen[s]) continue;
+    std::size_t size = 0;
+    stack.assign(1, s);
+    seen[s] = 1;
     while (!stack.empty()) {
       const std::size_t q = stack.back();
       stack.pop_back();
-      members.push_back(q);
+      ++size;
       g.neighbours(q, [&](std::size_t r, int, int) {
-        if (!label[r] && open[r]) label[r] = 1, stack.push_back(r);
+        if (!seen[r] && open[r]) seen[r] = 1, stack.push_back(r);
       });
     }
-    if (members.size() > best) {
-      best = members.size();
-      std::fill(room.begin(), room.end(), 0);
-      for (std::size_t q : members) room[q] = 1;
-    }
+    if (size > best) best = size, best_seed = s;
   }
-  return room;
+  return flood(g, {best_seed}, [&](std::size_t q) { return open[q] != 0; });
 }
 
 // A naris candidate: a 26-connected set of inner air voxels that face the room air.
@@ -204,16 +208,16 @@ struct NarisVoxels {
   Naris naris;
   std::vector<std::size_t> voxels;
   std::vector<Eigen::Vector3d> faces;  // centres of the voxel faces shared with the room air
-  double widest = 0.0;                 // the largest distance to tissue among its voxels (mm)
 };
 
+// Openings of the lumen (voxels at least `min_depth` from tissue, not the partial-volume rim along
+// the skin) to the room air.
 std::vector<NarisVoxels> find_nares(const ImageFrame& frame, const VoxelGrid& g, const Mask& inner,
                                     const Mask& room, const std::vector<float>& depth,
                                     double min_depth) {
   const std::size_t n = g.size();
   Mask faces(n, 0);
   for (std::size_t q = 0; q < n; ++q) {
-    // Lumen, not the partial-volume rim along the skin: at least `min_depth` from tissue.
     if (!inner[q] || depth[q] < min_depth) continue;
     g.neighbours(q, [&](std::size_t r, int, int) { faces[q] |= room[r]; });
   }
@@ -232,7 +236,6 @@ std::vector<NarisVoxels> find_nares(const ImageFrame& frame, const VoxelGrid& g,
       const std::size_t q = stack.back();
       stack.pop_back();
       c.voxels.push_back(q);
-      c.widest = std::max(c.widest, static_cast<double>(depth[q]));
       const Eigen::Vector3d ijk = g.ijk(q);
       g.neighbours(q, [&](std::size_t r, int axis, int dir) {
         if (!room[r]) return;
@@ -255,7 +258,6 @@ std::vector<NarisVoxels> find_nares(const ImageFrame& frame, const VoxelGrid& g,
             if (faces[r] && !seen[r]) seen[r] = 1, stack.push_back(r);
           }
     }
-    c.naris.voxels = c.voxels.size();
     c.naris.centre = weighted / c.naris.area;
     c.naris.normal = normal.norm() > 0 ? normal.normalized() : Eigen::Vector3d::Zero();
     out.push_back(std::move(c));
@@ -375,7 +377,7 @@ SideSplit split_sides(const ImageFrame& frame, const VoxelGrid& g, const Mask& n
       const int c = g.coord(q, ap);
       start = std::max(start, ap_sign > 0 ? c : g.n[ap] - 1 - c);
     }
-  start += static_cast<int>(std::ceil(10.0 / frame.spacing[ap]));
+  start += static_cast<int>(std::ceil(kChoanaSearch / frame.spacing[ap]));
   for (int t = start; t < g.n[ap]; ++t) {
     const int slice = ap_sign > 0 ? t : g.n[ap] - 1 - t;
     if (open_pairs[static_cast<std::size_t>(slice)] >= 3) {
@@ -400,20 +402,25 @@ struct Nares {
   double mid_x = 0.0;               // the midline between them (x, LPS: left +)
   std::vector<std::size_t> voxels;  // of both
   double level = 0.0;               // their area-weighted height (z)
+  // Those the airway of `side` is entered by.
+  std::vector<const NarisVoxels*> of(NasalSide side) const {
+    std::vector<const NarisVoxels*> out;
+    for (const NarisVoxels* c : {right, left})
+      if (c && (side == NasalSide::both || c == (side == NasalSide::right ? right : left)))
+        out.push_back(c);
+    return out;
+  }
 };
 
 Nares choose_nares(const ImageFrame& frame, const VoxelGrid& g, const Mask& inner, const Mask& room,
                    const std::vector<float>& depth, NasalSide side) {
-  // Lumen is at least kLumenDepth from tissue (on any grid: thin-slice CTs resolve the skin's
-  // partial-volume rim in more voxels, not in more millimetres).
-  const double min_opening = std::max(kLumenDepth, frame.spacing.maxCoeff());
+  const double min_opening = lumen_depth(frame);
   Nares nares;
   nares.candidates = find_nares(frame, g, inner, room, depth, min_opening);
   // The nostrils open downwards (and forwards): an opening that faces more to the front or the
   // side than to the feet is the mouth, a de-identification mask or the skin, not a naris.
   std::erase_if(nares.candidates, [&](const NarisVoxels& c) {
-    return c.widest < min_opening || c.naris.area < 4.0 * min_opening * min_opening ||
-           c.naris.normal[2] > -0.5;
+    return c.naris.area < 4.0 * min_opening * min_opening || c.naris.normal[2] > -0.5;
   });
   if (nares.candidates.empty())
     fail(
@@ -473,7 +480,8 @@ Mask separate_sinuses(const ImageFrame& frame, const VoxelGrid& g, const Mask& a
   std::optional<std::size_t> pharynx;
   for (std::size_t p : places) {
     const Eigen::Vector3d x = position(p);
-    if (depth[p] < kPharynxDepth || std::abs(x[0] - nares.mid_x) > 15.0 || x[2] > mean_level)
+    if (depth[p] < kPharynxDepth || std::abs(x[0] - nares.mid_x) > kPharynxOffMidline ||
+        x[2] > mean_level)
       continue;
     if (!pharynx || x[2] < position(*pharynx)[2]) pharynx = p;
   }
@@ -496,7 +504,7 @@ Mask select_side(const ImageFrame& frame, const VoxelGrid& g, const Mask& nasal,
   SideSplit split;
   if (nares.right && nares.left) {
     split = split_sides(frame, g, nasal, depth, nares.right->voxels, nares.left->voxels, ap,
-                        ap_sign, std::max(kLumenDepth, frame.spacing.maxCoeff()));
+                        ap_sign, lumen_depth(frame));
     out.choana = split.choana;
   }
   auto behind = [&](std::size_t q, int slice) {  // strictly posterior of `slice`
@@ -506,7 +514,7 @@ Mask select_side(const ImageFrame& frame, const VoxelGrid& g, const Mask& nasal,
   if (o.side == NasalSide::both) {
     if (o.keep_nasopharynx || !out.choana) return nasal;
     // Both cavities end a little behind the choanae, where they have joined.
-    const int extra = static_cast<int>(std::ceil(5.0 / frame.spacing[ap]));
+    const int extra = static_cast<int>(std::ceil(kBehindChoanae / frame.spacing[ap]));
     const int cut = std::clamp(*out.choana + ap_sign * extra, 0, g.n[ap] - 1);
     out.outlet = fmt::format("{}={}", axis_letter, cut);
     return flood(g, nares.voxels, [&](std::size_t q) { return nasal[q] && !behind(q, cut); });
@@ -516,7 +524,6 @@ Mask select_side(const ImageFrame& frame, const VoxelGrid& g, const Mask& nasal,
         "the {} side cannot be separated: no choana found (the boundary between the sides never "
         "runs through open air: is the nasopharynx in the scan?)",
         nasal_side_name(o.side));
-  const NarisVoxels* mine = o.side == NasalSide::right ? nares.right : nares.left;
   const std::uint8_t my_side = o.side == NasalSide::right ? 1 : 2;
   auto keep = [&](std::size_t q) {
     if (!nasal[q]) return false;
@@ -525,7 +532,29 @@ Mask select_side(const ImageFrame& frame, const VoxelGrid& g, const Mask& nasal,
   };
   if (out.choana && !o.keep_nasopharynx)
     out.outlet = fmt::format("{}={}", axis_letter, *out.choana);
-  return flood(g, mine->voxels, keep);
+  return flood(g, nares.of(o.side).front()->voxels, keep);
+}
+
+// The inlet: the area-weighted plane of the openings. They are caps that bulge into the
+// vestibule where the room air reaches in (a wide nostril lets the closing's balls in), so the
+// plane goes in past the deepest tenth of their faces by kLumenDepth, where the vestibule is one
+// whole section.
+std::string inlet_plane(const std::vector<const NarisVoxels*>& nares) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero();
+  double area = 0.0;
+  for (const NarisVoxels* c : nares) {
+    centre += c->naris.area * c->naris.centre;
+    normal += c->naris.area * c->naris.normal;
+    area += c->naris.area;
+  }
+  centre /= area;
+  normal.normalize();
+  std::vector<double> depths;
+  for (const NarisVoxels* c : nares)
+    for (const Eigen::Vector3d& f : c->faces) depths.push_back((f - centre).dot(normal));
+  const auto tenth = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 10);
+  std::nth_element(depths.begin(), tenth, depths.end());
+  return plane_text(centre + (*tenth - kLumenDepth) * normal, normal);
 }
 
 }  // namespace
@@ -594,33 +623,11 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
     for (int a = 0; a < 3; ++a)
       if (g.coord(q, a) == 0 || g.coord(q, a) + 1 == g.n[a]) result[q] = 0;
 
-  // The inlet: the plane of the nares' openings (area-weighted), across the vestibule.
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero();
-  double area = 0.0;
-  std::vector<const NarisVoxels*> used;
-  for (const NarisVoxels* c : {nares.right, nares.left}) {
-    if (!c || (o.side == NasalSide::right && c != nares.right) ||
-        (o.side == NasalSide::left && c != nares.left))
-      continue;
-    used.push_back(c);
-    Naris naris = c->naris;
-    naris.right = c == nares.right;
-    out.nares.push_back(naris);
-    centre += naris.area * naris.centre;
-    normal += naris.area * naris.normal;
-    area += naris.area;
+  for (const NarisVoxels* c : nares.of(o.side)) {
+    out.nares.push_back(c->naris);
+    out.nares.back().right = c == nares.right;
   }
-  centre /= area;
-  normal.normalize();
-  // The openings are caps that bulge into the vestibule where the room air reaches in (a wide
-  // nostril lets the closing's balls in): the plane goes in past the deepest tenth of their
-  // faces by kLumenDepth, where the vestibule is one whole section.
-  std::vector<double> depths;
-  for (const NarisVoxels* c : used)
-    for (const Eigen::Vector3d& f : c->faces) depths.push_back((f - centre).dot(normal));
-  const auto tenth = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 10);
-  std::nth_element(depths.begin(), tenth, depths.end());
-  out.inlet = plane_text(centre + (*tenth - kLumenDepth) * normal, normal);
+  out.inlet = inlet_plane(nares.of(o.side));
 
   std::size_t kept = 0;
   for (auto v : result) kept += v;

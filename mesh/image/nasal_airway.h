@@ -34,8 +34,7 @@ struct NasalAirwayOptions {
 // One naris: where the vestibule's air meets the room air.
 struct Naris {
   bool right = false;  // the patient's right
-  std::size_t voxels = 0;
-  double area = 0.0;  // mm², of the voxel faces shared with the room air
+  double area = 0.0;   // mm², of the voxel faces shared with the room air
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, towards the room
 };

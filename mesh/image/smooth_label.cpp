@@ -4,15 +4,14 @@
 #include <cmath>
 
 #include "core/error.h"
-#include "core/parallel.h"
 #include "mesh/image/distance_transform.h"
+#include "mesh/image/grid_lines.h"
 
 namespace naris {
 namespace {
 
 // Gaussian smoothing along one axis in place, the border value repeated beyond the volume.
 void smooth_axis(Volume<float>& v, int axis, double sigma_voxels, int threads) {
-  const auto& n = v.frame.dims;
   const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma_voxels)));
   std::vector<double> kernel(static_cast<std::size_t>(2 * radius + 1));
   double sum = 0.0;
@@ -20,30 +19,47 @@ void smooth_axis(Volume<float>& v, int axis, double sigma_voxels, int threads) {
     sum += kernel[static_cast<std::size_t>(t + radius)] =
         std::exp(-0.5 * t * t / (sigma_voxels * sigma_voxels));
   for (double& k : kernel) k /= sum;
-  const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-  const std::size_t stride = axis == 0   ? 1
-                             : axis == 1 ? static_cast<std::size_t>(n[0])
-                                         : static_cast<std::size_t>(n[0]) * n[1];
-  const std::size_t lines = static_cast<std::size_t>(n[a1]) * static_cast<std::size_t>(n[a2]);
-  run_threads(thread_count(threads), [&](unsigned t, unsigned count) {
-    const auto [begin, end] = share(lines, t, count);
-    std::vector<float> line(static_cast<std::size_t>(n[axis]));
-    for (std::size_t l = begin; l < end; ++l) {
-      std::array<int, 3> ijk{};
-      ijk[a1] = static_cast<int>(l % static_cast<std::size_t>(n[a1]));
-      ijk[a2] = static_cast<int>(l / static_cast<std::size_t>(n[a1]));
-      const std::size_t first = v.frame.index(ijk[0], ijk[1], ijk[2]);
-      for (int x = 0; x < n[axis]; ++x)
-        line[static_cast<std::size_t>(x)] = v.values[first + stride * x];
-      for (int x = 0; x < n[axis]; ++x) {
+  transform_lines(v.frame, v.values, axis, threads, [&] {
+    return [&, copy = std::vector<float>()](std::span<float> line) mutable {
+      copy.assign(line.begin(), line.end());
+      const int last = static_cast<int>(line.size()) - 1;
+      for (int x = 0; x <= last; ++x) {
         double s = 0.0;
         for (int d = -radius; d <= radius; ++d)
           s += kernel[static_cast<std::size_t>(d + radius)] *
-               line[static_cast<std::size_t>(std::clamp(x + d, 0, n[axis] - 1))];
-        v.values[first + stride * x] = static_cast<float>(s);
+               copy[static_cast<std::size_t>(std::clamp(x + d, 0, last))];
+        line[static_cast<std::size_t>(x)] = static_cast<float>(s);
       }
-    }
+    };
   });
+}
+
+// Smoothing a distance moves its level zero towards the concave side by σ²/2 times its
+// Laplacian (σ²/R inside a sphere of radius R); one step of the heat equation backwards,
+// φ − (σ²/2) Δφ, puts it back where the curvature is smooth. σ in mm.
+void undo_shrinkage(Volume<float>& field, double sigma_mm) {
+  const auto& d = field.frame.dims;
+  const Eigen::Vector3d& sp = field.frame.spacing;
+  const double half_sigma2 = 0.5 * sigma_mm * sigma_mm;
+  std::vector<float> corrected(field.values);
+  for (int k = 0; k < d[2]; ++k)
+    for (int j = 0; j < d[1]; ++j)
+      for (int i = 0; i < d[0]; ++i) {
+        const std::size_t q = field.frame.index(i, j, k);
+        const int c[3] = {i, j, k};
+        double laplacian = 0.0;
+        for (int a = 0; a < 3; ++a) {
+          if (d[a] < 3) continue;
+          int lo[3] = {i, j, k}, hi[3] = {i, j, k};
+          lo[a] = std::max(0, c[a] - 1), hi[a] = std::min(d[a] - 1, c[a] + 1);
+          laplacian +=
+              (field.values[field.frame.index(lo[0], lo[1], lo[2])] - 2.0 * field.values[q] +
+               field.values[field.frame.index(hi[0], hi[1], hi[2])]) /
+              (sp[a] * sp[a]);
+        }
+        corrected[q] = static_cast<float>(field.values[q] - half_sigma2 * laplacian);
+      }
+  field.values = std::move(corrected);
 }
 
 }  // namespace
@@ -76,33 +92,7 @@ Volume<float> smooth_label_field(const Volume<std::uint8_t>& mask, const SmoothL
   for (int axis = 0; axis < 3; ++axis)
     if (mask.frame.dims[axis] > 1)  // isotropic in millimetres: σ voxels of the finest axis
       smooth_axis(field, axis, o.sigma * h / mask.frame.spacing[axis], o.threads);
-  // Smoothing a distance moves its level zero towards the concave side by σ²/2 times its
-  // Laplacian (σ²/R inside a sphere of radius R); one step of the heat equation backwards,
-  // φ − (σ²/2) Δφ, puts it back where the curvature is smooth.
-  {
-    const auto& d = mask.frame.dims;
-    const Eigen::Vector3d& sp = mask.frame.spacing;
-    std::vector<float> corrected(field.values);
-    for (int k = 0; k < d[2]; ++k)
-      for (int j = 0; j < d[1]; ++j)
-        for (int i = 0; i < d[0]; ++i) {
-          const std::size_t q = mask.frame.index(i, j, k);
-          const int c[3] = {i, j, k};
-          double laplacian = 0.0;
-          for (int a = 0; a < 3; ++a) {
-            if (d[a] < 3) continue;
-            int lo[3] = {i, j, k}, hi[3] = {i, j, k};
-            lo[a] = std::max(0, c[a] - 1), hi[a] = std::min(d[a] - 1, c[a] + 1);
-            laplacian +=
-                (field.values[mask.frame.index(lo[0], lo[1], lo[2])] - 2.0 * field.values[q] +
-                 field.values[mask.frame.index(hi[0], hi[1], hi[2])]) /
-                (sp[a] * sp[a]);
-          }
-          const double sigma_mm2 = o.sigma * o.sigma * h * h;
-          corrected[q] = static_cast<float>(field.values[q] - 0.5 * sigma_mm2 * laplacian);
-        }
-    field.values = std::move(corrected);
-  }
+  undo_shrinkage(field, o.sigma * h);
   // Each voxel stays on its own side, `margin` of a voxel from the level zero.
   const auto m = static_cast<float>(o.margin * h);
   for (std::size_t q = 0; q < n; ++q)

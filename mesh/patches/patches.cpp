@@ -6,16 +6,14 @@
 #include <regex>
 
 #include "core/error.h"
+#include "core/text.h"
 
 namespace naris {
 namespace {
 
 std::vector<double> parse_numbers(const std::string& text, const std::string& context) {
   std::vector<double> out;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t end = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, end - start);
+  for (const std::string& item : split_list(text)) {
     try {
       std::size_t used = 0;
       out.push_back(std::stod(item, &used));
@@ -24,7 +22,6 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& co
       fail("'{}': '{}' is not a number", context, item);
     }
     if (!std::isfinite(out.back())) fail("'{}': '{}' is not a finite number", context, item);
-    start = end + 1;
   }
   return out;
 }

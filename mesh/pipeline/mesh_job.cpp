@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/json.h"
 #include "core/log.h"
+#include "core/text.h"
 #include "core/units.h"
 #include "mesh/image/image_jobs.h"
 #include "mesh/image/smooth_label.h"
@@ -24,29 +25,28 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The labels of "3,5" or of segment names, each checked against what the image holds.
-std::vector<int> parse_labels(const std::string& text, const Volume<float>& volume,
-                              const MeshJob& job, const VolumeInfo& info) {
+// The labels present in an image (integer values), each with its segment name where the file
+// names it: "0, 3 (right half), 5 (left half)".
+std::string labels_present(const Volume<float>& volume, const VolumeInfo& info) {
   std::set<int> present;
   for (float v : volume.values)
     if (v == std::floor(v) && std::abs(v) < 1e6f) present.insert(static_cast<int>(v));
-  auto known = [&] {
-    std::string list;
-    for (int l : present) {
-      const auto it = info.label_names.find(l);
-      list += fmt::format("{}{}{}", list.empty() ? "" : ", ", l,
-                          it == info.label_names.end() ? "" : " (" + it->second + ")");
-    }
-    return list;
-  };
+  std::string list;
+  for (int l : present) {
+    const auto it = info.label_names.find(l);
+    list += fmt::format("{}{}{}", list.empty() ? "" : ", ", l,
+                        it == info.label_names.end() ? "" : " (" + it->second + ")");
+  }
+  return list;
+}
+
+// The labels of "3,5" or of segment names, each checked against what the image holds.
+std::vector<int> parse_labels(const std::string& text, const Volume<float>& volume,
+                              const MeshJob& job, const VolumeInfo& info) {
   std::vector<int> labels;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', start), text.size());
-    std::string token = text.substr(start, comma - start);
+  for (std::string token : split_list(text)) {
     token.erase(0, token.find_first_not_of(' '));
     token.erase(token.find_last_not_of(' ') + 1);
-    start = comma + 1;
     if (token.empty()) fail("label '{}': an empty item (give L or L1,L2,…)", text);
     int label = 0;
     const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), label);
@@ -54,12 +54,14 @@ std::vector<int> parse_labels(const std::string& text, const Volume<float>& volu
       const auto it = std::find_if(info.label_names.begin(), info.label_names.end(),
                                    [&](const auto& kv) { return kv.second == token; });
       if (it == info.label_names.end())
-        fail("{}: no label '{}' (labels present: {})", job.input.string(), token, known());
+        fail("{}: no label '{}' (labels present: {})", job.input.string(), token,
+             labels_present(volume, info));
       label = it->first;
     }
-    if (!present.count(label))
+    if (std::none_of(volume.values.begin(), volume.values.end(),
+                     [&](float v) { return v == static_cast<float>(label); }))
       fail("{}: empty segmentation: no voxel has label {} (labels present: {})", job.input.string(),
-           label, known());
+           label, labels_present(volume, info));
     labels.push_back(label);
   }
   return labels;
@@ -105,15 +107,9 @@ mve::VolumeField make_field(Volume<float>& volume, const MeshJob& job, MeshJobRe
   std::size_t inside = 0;
   for (float v : volume.values) inside += is_inside(mode, v, level);
   if (inside == 0) {
-    if (mode == InsideRule::label) {
-      std::set<float> present;
-      for (float v : volume.values) {
-        present.insert(v);
-        if (present.size() > 8) break;
-      }
+    if (mode == InsideRule::label)
       fail("{}: empty segmentation: no voxel has label {} (labels present: {})", job.input.string(),
-           level, fmt::join(present, ", "));
-    }
+           level, labels_present(volume, info));
     fail("{}: no voxel is {} the threshold {}: nothing to mesh", job.input.string(),
          inside_rule_name(mode), level);
   }
@@ -158,18 +154,21 @@ Json quality_json(const QualityReport& q) {
   return out;
 }
 
-// "auto": the plane the segmentation found (naris segment --airway nasal), from its sidecar.
-std::string cut_plane_text(const std::string& text, const std::string& name,
-                           const fs::path& input) {
+// "auto": the plane the segmentation found (naris segment --airway nasal), from its sidecar,
+// read once for both planes.
+std::string cut_plane_text(const std::string& text, const std::string& name, const fs::path& input,
+                           std::optional<Json>& sidecar) {
   if (text != "auto") return text;
-  const fs::path sidecar = segmentation_sidecar(input);
-  if (!fs::is_regular_file(sidecar))
-    fail("{} 'auto' takes the plane from {}, which is absent (segment with --airway nasal)", name,
-         sidecar.string());
-  const Json planes = read_json_file(sidecar);
-  if (!planes.contains(name) || !planes[name].is_string())
-    fail("{} has no {} plane: give one explicitly", sidecar.string(), name);
-  return planes[name].get<std::string>();
+  const fs::path path = segmentation_sidecar(input);
+  if (!sidecar) {
+    if (!fs::is_regular_file(path))
+      fail("{} 'auto' takes the plane from {}, which is absent (segment with --airway nasal)", name,
+           path.string());
+    sidecar = read_json_file(path);
+  }
+  if (!sidecar->contains(name) || !(*sidecar)[name].is_string())
+    fail("{} has no {} plane: give one explicitly", path.string(), name);
+  return (*sidecar)[name].get<std::string>();
 }
 
 }  // namespace
@@ -182,8 +181,10 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
     fail("subdivide is {}: give 0 to 3 levels (each multiplies the cells by 8)", job.subdivisions);
   ensure_writable_folder(job.output.parent_path());
   std::vector<Cut> cuts;
+  std::optional<Json> sidecar;
   for (const auto& [name, text] : {std::pair{"inlet", job.inlet}, std::pair{"outlet", job.outlet}})
-    if (text) cuts.push_back({name, parse_cut_plane(cut_plane_text(*text, name, job.input))});
+    if (text)
+      cuts.push_back({name, parse_cut_plane(cut_plane_text(*text, name, job.input, sidecar))});
   std::vector<Region> regions;
   for (const auto& text : job.regions) regions.push_back(parse_region(text));
 

@@ -14,6 +14,7 @@
 #include "mesh/image/nasal_airway.h"
 #include "mesh/image/read_volume.h"
 #include "postproc/figures/canvas.h"
+#include "tests/mesh/image/expert_labels.h"
 
 using namespace naris;
 namespace fs = std::filesystem;
@@ -44,12 +45,8 @@ struct Score {
 
 Score score(const ImageFrame& f, const std::vector<std::uint8_t>& a, const Volume<float>& labels,
             std::initializer_list<int> wanted) {
-  std::vector<std::uint8_t> b(a.size(), 0);
-  std::size_t na = 0, nb = 0, both = 0;
-  for (std::size_t q = 0; q < a.size(); ++q) {
-    for (int l : wanted) b[q] |= labels.values[q] == static_cast<float>(l);
-    na += a[q], nb += b[q], both += a[q] && b[q];
-  }
+  const std::vector<std::uint8_t> b = testing::label_mask(labels, wanted);
+  const testing::Overlap o = testing::overlap(a, b);
   const auto sa = surface(f, a), sb = surface(f, b);
   const auto da = squared_distance(f, sa), db = squared_distance(f, sb);
   double sum = 0.0;
@@ -58,8 +55,7 @@ Score score(const ImageFrame& f, const std::vector<std::uint8_t>& a, const Volum
     if (sa[q]) sum += std::sqrt(db[q]), ++count;
     if (sb[q]) sum += std::sqrt(da[q]), ++count;
   }
-  return {2.0 * static_cast<double>(both) / static_cast<double>(na + nb),
-          static_cast<double>(na) / static_cast<double>(nb), sum / static_cast<double>(count)};
+  return {o.dice, o.volume_ratio, sum / static_cast<double>(count)};
 }
 
 // Coronal slices of the CT with the naris mask and the expert's label over it: blue both, red
@@ -126,11 +122,7 @@ int main(int argc, char** argv) {
   for (const char* name : {"P005", "P045", "P055"}) {
     const Volume<float> ct = read_volume(dir / (std::string(name) + "_img.nrrd"));
     const Volume<float> labels = read_volume(dir / (std::string(name) + "_seg.nrrd"));
-    int expert_choana = -1;
-    for (int k = 0; k < labels.frame.dims[2]; ++k)
-      for (int j = 0; j < labels.frame.dims[1]; ++j)
-        for (int i = 0; i < labels.frame.dims[0]; ++i)
-          if (labels.at(i, j, k) == 3.0f) expert_choana = std::max(expert_choana, j);
+    const int expert_choana = testing::last_slice_j(labels, 3.0f);
     Stopwatch clock;
     const NasalAirway right = segment_nasal_airway(ct, NasalAirwayOptions{});
     const double t_right = clock.seconds();

@@ -166,11 +166,12 @@ TEST(LabelMap, InterpolatesLabelByLabel) {
     for (int j = 0; j < 40; ++j)
       for (int i = 0; i < 40; ++i)
         if (std::hypot(i - 19.5, j - 19.5) < 10.0 + 2.0 * k) v.at(i, j, k) = i < 20 ? 3.0f : 5.0f;
-  ASSERT_TRUE(is_label_map(v));
+  const std::vector<float> labels = map_labels(v);
+  ASSERT_EQ(labels, (std::vector<float>{3.0f, 5.0f}));
   Volume<float> binary = v;
   for (float& x : binary.values) x = x > 0.0f ? 1.0f : 0.0f;
-  EXPECT_FALSE(is_label_map(binary));
-  const Volume<float> out = interpolate_label_map(v, 2, 2, 2);
+  EXPECT_TRUE(map_labels(binary).empty());
+  const Volume<float> out = interpolate_label_map(v, labels, 2, 2, 2);
   ASSERT_EQ(out.frame.dims[2], 13);
   EXPECT_DOUBLE_EQ(out.frame.spacing[2], 0.5);
   double count3 = 0.0, count5 = 0.0;

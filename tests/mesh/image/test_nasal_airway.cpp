@@ -7,37 +7,13 @@
 #include "core/error.h"
 #include "mesh/image/nasal_airway.h"
 #include "mesh/image/read_volume.h"
+#include "tests/mesh/image/expert_labels.h"
 
 namespace naris {
 namespace {
 namespace fs = std::filesystem;
-
-struct Overlap {
-  double dice = 0.0, volume_ratio = 0.0;
-};
-Overlap overlap(const Volume<std::uint8_t>& mask, const Volume<float>& labels,
-                std::initializer_list<int> wanted) {
-  std::size_t a = 0, b = 0, both = 0;
-  for (std::size_t q = 0; q < mask.values.size(); ++q) {
-    bool in = false;
-    for (int l : wanted) in |= labels.values[q] == static_cast<float>(l);
-    a += mask.values[q];
-    b += in;
-    both += mask.values[q] && in;
-  }
-  return {2.0 * static_cast<double>(both) / static_cast<double>(a + b),
-          static_cast<double>(a) / static_cast<double>(b)};
-}
-
-// The last slice along j that holds the expert's right cavity (label 3): its choana.
-int expert_choana(const Volume<float>& labels) {
-  int last = -1;
-  for (int k = 0; k < labels.frame.dims[2]; ++k)
-    for (int j = 0; j < labels.frame.dims[1]; ++j)
-      for (int i = 0; i < labels.frame.dims[0]; ++i)
-        if (labels.at(i, j, k) == 3.0f) last = std::max(last, j);
-  return last;
-}
+using testing::label_mask;
+using testing::overlap;
 
 class NasalSeg : public ::testing::TestWithParam<const char*> {};
 
@@ -52,18 +28,19 @@ TEST_P(NasalSeg, AirwayMatchesTheExpertLabels) {
   both.side = NasalSide::both;
   both.keep_nasopharynx = true;
   const NasalAirway all = segment_nasal_airway(ct, both);
-  const Overlap o = overlap(all.mask, labels, {3, 4, 5});
+  const testing::Overlap o = overlap(all.mask.values, label_mask(labels, {3, 4, 5}));
   EXPECT_GE(o.dice, 0.80) << "both cavities with the nasopharynx";
   EXPECT_NEAR(o.volume_ratio, 1.0, 0.15);
   ASSERT_EQ(all.nares.size(), 2u);
   EXPECT_GT(all.sinus_ml, 20.0) << "the maxillary sinuses are left out";
 
   const NasalAirway right = segment_nasal_airway(ct, NasalAirwayOptions{});
-  const Overlap r = overlap(right.mask, labels, {3});
+  const testing::Overlap r = overlap(right.mask.values, label_mask(labels, {3}));
   EXPECT_GE(r.dice, 0.80) << "right cavity";
-  // The issue asks for 15 %; P005's right cavity is 0.81 of the expert's (partial-volume voxels
-  // along the septum and the superior meatus, docs/results/anatomy.md). This guards what holds.
-  EXPECT_NEAR(r.volume_ratio, 1.0, 0.20);
+  // The issue asks for 15 %, which P045 and P055 meet; P005's right cavity is 0.81 of the
+  // expert's (partial-volume voxels along the septum, the superior meatus: a known miss,
+  // docs/results/anatomy.md), guarded at 20 % so that it cannot get worse unseen.
+  EXPECT_NEAR(r.volume_ratio, 1.0, std::string(GetParam()) == "P005" ? 0.20 : 0.15);
   ASSERT_EQ(right.nares.size(), 1u);
   EXPECT_TRUE(right.nares[0].right);
   // An adult naris opens downwards, tens to a few hundred mm² of voxel faces.
@@ -71,7 +48,7 @@ TEST_P(NasalSeg, AirwayMatchesTheExpertLabels) {
   EXPECT_GT(right.nares[0].area, 20.0);
   EXPECT_LT(right.nares[0].area, 400.0);
   ASSERT_TRUE(right.choana.has_value());
-  EXPECT_NEAR(*right.choana, expert_choana(labels), 3);
+  EXPECT_NEAR(*right.choana, testing::last_slice_j(labels, 3.0f), 3);
   EXPECT_EQ(right.outlet, "j=" + std::to_string(*right.choana));
   // Nothing of the airway on the scan's border: the mesher closes it with wall.
   const auto& d = right.mask.frame.dims;
