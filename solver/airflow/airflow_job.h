@@ -53,11 +53,16 @@ struct AirflowResult {
   struct Patch {
     std::string name;
     double area_mm2 = 0.0;
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();  // consistent (ns/reaction_force.h)
+    // The surface integral of the traction from the cells' gradients, to compare.
     Eigen::Vector3d pressure_force = Eigen::Vector3d::Zero(),
                     viscous_force = Eigen::Vector3d::Zero();
     double mean_shear = 0.0, max_shear = 0.0;  // Pa
   };
   std::vector<Patch> patches;  // forces (N) and wall shear stress per patch
+  // |Σ patch forces + momentum carried out| over the largest wall force: how well the
+  // consistent forces close the momentum balance.
+  double momentum_balance = 0.0;
   std::vector<continuation::ContinuationStep> steps;
   std::size_t cells = 0, nodes = 0;
   double seconds = 0.0, restarted_from = 0.0;  // the checkpoint's Re, 0 without --restart

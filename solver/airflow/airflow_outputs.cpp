@@ -11,6 +11,7 @@
 #include "core/log.h"
 #include "core/units.h"
 #include "mesh/io/write_vtk.h"
+#include "solver/ns/reaction_force.h"
 #include "solver/ns/wall_stress.h"
 
 namespace naris::airflow {
@@ -113,10 +114,22 @@ ns::WallStress flow_results(const AirflowJob& job, const Partition& part, const 
     stress.shear = gather_face_shear(stress.shear, part.piece.face_index, part.boundary_faces,
                                      PETSC_COMM_WORLD, 0);
   }
+  const std::vector<Eigen::Vector3d> forces = solves.reaction_forces(field, r.reynolds);
+  Eigen::Vector3d balance = solves.momentum_outflow(field);
+  double largest_wall = 0.0;
+  const std::vector<ns::PatchKind> kinds = ns::airflow_patch_kinds(part.piece.mesh);
+  for (std::size_t q = 0; q < forces.size(); ++q) {
+    balance += forces[q];
+    if (kinds[q] == ns::PatchKind::wall) largest_wall = std::max(largest_wall, forces[q].norm());
+  }
+  r.momentum_balance = largest_wall > 0.0 ? balance.norm() / largest_wall : 0.0;
   const double d_in = r.d_in_mm * kMm, force_scale = pscale * d_in * d_in;
-  for (const auto& p : stress.patches)
-    r.patches.push_back({p.name, p.area * r.d_in_mm * r.d_in_mm, p.pressure * force_scale,
-                         p.viscous * force_scale, p.mean_shear * pscale, p.max_shear * pscale});
+  for (std::size_t q = 0; q < stress.patches.size(); ++q) {
+    const PatchForce& p = stress.patches[q];
+    r.patches.push_back({p.name, p.area * r.d_in_mm * r.d_in_mm, forces[q] * force_scale,
+                         p.pressure * force_scale, p.viscous * force_scale, p.mean_shear * pscale,
+                         p.max_shear * pscale});
+  }
   return stress;
 }
 
@@ -240,13 +253,15 @@ void write_airflow_outputs(const AirflowJob& job, Partition& part, const PieceSo
 void write_summary_json(const AirflowJob& job, AirflowResult& r) {
   Json patches = Json::array(), steps = Json::array();
   for (const auto& p : r.patches) {
-    Json pressure = Json::array(), viscous = Json::array();
+    Json force = Json::array(), pressure = Json::array(), viscous = Json::array();
     for (int c = 0; c < 3; ++c) {
+      force.push_back(significant(p.force[c]));
       pressure.push_back(significant(p.pressure_force[c]));
       viscous.push_back(significant(p.viscous_force[c]));
     }
     patches.push_back({{"name", p.name},
                        {"area_mm2", significant(p.area_mm2)},
+                       {"force_n", force},
                        {"pressure_force_n", pressure},
                        {"viscous_force_n", viscous},
                        {"mean_wall_shear_pa", significant(p.mean_shear)},
@@ -281,6 +296,7 @@ void write_summary_json(const AirflowJob& job, AirflowResult& r) {
       {"resistance_pa_s_ml", significant(r.resistance)},
       {"max_speed_m_s", significant(r.max_speed)},
       {"patches", patches},
+      {"momentum_balance", significant(r.momentum_balance, 3)},
       {"continuation", steps},
       {"mpi_ranks", r.ranks},
       {"seconds", significant(r.seconds)},
@@ -305,14 +321,15 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
       "  flow      {:.2f} mL/s in, {:.2f} mL/s out\n"
       "  pressure  drop inlet→outlet {:.3f} Pa; resistance {:.4f} Pa·s/mL\n"
       "  speed     max {:.3f} m/s\n"
-      "  wall      shear stress mean {:.4f} Pa, max {:.4f} Pa; force {:.3e} N\n"
+      "  wall      shear stress mean {:.4f} Pa, max {:.4f} Pa; force {:.3e} N (surface "
+      "integral {:.3e} N); momentum balance {:.1e}\n"
       "  solve     {} continuation steps, {} nonlinear steps, {:.1f} s, peak {}\n"
       "  wrote     {}",
       job.mesh.filename().string(), r.cells, r.nodes, r.inlet_area_mm2, r.inlet_perimeter_mm,
       r.d_in_mm, profile_name(job), r.reynolds, r.u_in, job.viscosity, job.density, r.flow_ml_s,
       r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance, r.max_speed, wall.mean_shear,
-      wall.max_shear, (wall.pressure_force + wall.viscous_force).norm(), r.steps.size(), picard,
-      r.seconds,
+      wall.max_shear, wall.force.norm(), (wall.pressure_force + wall.viscous_force).norm(),
+      r.momentum_balance, r.steps.size(), picard, r.seconds,
       r.ranks > 1 ? fmt::format("{:.0f} MB per rank, {:.0f} MB on {} ranks",
                                 megabytes(r.peak_memory), megabytes(r.total_peak_memory), r.ranks)
                   : fmt::format("{:.0f} MB", megabytes(r.peak_memory)),

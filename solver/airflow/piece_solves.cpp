@@ -10,6 +10,7 @@
 #include "solver/nonlinear/navier_stokes_solver.h"
 #include "solver/ns/distributed_field.h"
 #include "solver/ns/patch_integrals.h"
+#include "solver/ns/reaction_force.h"
 
 namespace naris::airflow {
 
@@ -91,6 +92,21 @@ double PieceSolves::max_speed(const ns::FlowField& f) const {
 double PieceSolves::outlet_flux(const ns::FlowField& f) const {
   double flux = ns::patch_flux(piece_, f.velocity, outlet_);
   MPI_Allreduce(MPI_IN_PLACE, &flux, 1, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+  return flux;
+}
+
+std::vector<Eigen::Vector3d> PieceSolves::reaction_forces(const ns::FlowField& f,
+                                                          double reynolds) const {
+  ns::FlowProblem problem = problem_;
+  problem.reynolds = reynolds;
+  return ns::reaction_forces(piece_, numbering_, f, problem, ns::airflow_patch_kinds(piece_),
+                             PETSC_COMM_WORLD);
+}
+
+Eigen::Vector3d PieceSolves::momentum_outflow(const ns::FlowField& f) const {
+  Eigen::Vector3d flux = ns::patch_momentum_flux(piece_, f.velocity, inlet_) +
+                         ns::patch_momentum_flux(piece_, f.velocity, outlet_);
+  MPI_Allreduce(MPI_IN_PLACE, flux.data(), 3, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
   return flux;
 }
 

@@ -4,7 +4,9 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "solver/ns/backflow.h"
 #include "solver/ns/node_graph.h"
+#include "solver/ns/recovered_gradient.h"
 
 namespace naris::ns {
 
@@ -105,39 +107,9 @@ Mat OseenSystem::newton_operator(const std::vector<Eigen::Vector3d>& advection, 
 }
 
 void OseenSystem::recover_gradient(const std::vector<Eigen::Vector3d>& a) {
-  gradient_.assign(mesh_.nodes.size(), Eigen::Matrix<double, 1, 9>::Zero());
-  std::vector<double> mass(mesh_.nodes.size(), 0.0);
   // Every cell of the piece: the gradient is needed at the nodes of owned cells, and the
   // piece holds all the cells around those.
-  auto run = [&](const auto& cells, auto element) {
-    using E = decltype(element);
-    constexpr int N = E::nodes;
-    Eigen::Matrix<double, N, 3> X, A;
-    for (const auto& cell : cells) {
-      for (int i = 0; i < N; ++i) {
-        X.row(i) = mesh_.nodes[static_cast<std::size_t>(cell[i])].transpose();
-        A.row(i) = a[static_cast<std::size_t>(cell[i])].transpose();
-      }
-      for (std::size_t q = 0; q < ShapeTable<E>::get().points.size(); ++q) {
-        const auto m = fem::map_to_cell<E>(X, ShapeTable<E>::get().shapes[q]);
-        const double w = ShapeTable<E>::get().points[q].weight * m.det_jacobian;
-        const Eigen::Matrix3d g = A.transpose() * m.gradient;  // g(c, d) = ∂a_c/∂x_d
-        const Eigen::Matrix<double, 1, 9> row =
-            Eigen::Map<const Eigen::Matrix<double, 1, 9>>(Eigen::Matrix3d(g.transpose()).data());
-        for (int i = 0; i < N; ++i) {
-          const auto n = static_cast<std::size_t>(cell[i]);
-          gradient_[n] += w * m.value[i] * row;
-          mass[n] += w * m.value[i];
-        }
-      }
-    }
-  };
-  run(mesh_.tets, fem::Tet4{});
-  run(mesh_.pyramids, fem::Pyr5{});
-  run(mesh_.hexes, fem::Hex8{});
-  for (std::size_t n = 0; n < mass.size(); ++n)
-    if (mass[n] > 0.0) gradient_[n] /= mass[n];
-  lumped_mass_ = std::move(mass);
+  ns::recover_gradient(mesh_, a, gradient_, lumped_mass_);
 }
 
 void OseenSystem::add_pseudo_time(const std::vector<Eigen::Vector3d>& advection, double nu,
@@ -191,36 +163,11 @@ void OseenSystem::assemble_backflow(const std::vector<Eigen::Vector3d>& advectio
     const auto node = [&](int i) {
       return static_cast<std::size_t>(v[static_cast<std::size_t>(i)]);
     };
-    Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
+    Eigen::Matrix4d M;
     // Newton's share, d/du of the term with a = u: −β ∫ H(−u·n) (δu·n) (u·w); rows and
     // columns (4i + c) like PETSc's block.
-    Eigen::Matrix<double, 16, 16> D = Eigen::Matrix<double, 16, 16>::Zero();
-    // Fan triangles from v[0], three edge-midpoint points each (degree 2 on every triangle).
-    for (int k = 1; k + 1 < m; ++k) {
-      const int tri[3] = {0, k, k + 1};
-      const Eigen::Vector3d an =
-          0.5 * (mesh_.nodes[node(tri[1])] - mesh_.nodes[node(tri[0])])
-                    .cross(mesh_.nodes[node(tri[2])] - mesh_.nodes[node(tri[0])]);
-      const double area = an.norm();
-      if (area <= 0.0) continue;
-      const Eigen::Vector3d normal = an / area;
-      for (int q = 0; q < 3; ++q) {
-        double phi[3] = {0.5, 0.5, 0.5};
-        phi[q] = 0.0;
-        Eigen::Vector3d a = Eigen::Vector3d::Zero();
-        for (int i = 0; i < 3; ++i) a += phi[i] * advection[node(tri[i])];
-        const double inflow = std::min(0.0, a.dot(normal));
-        if (inflow == 0.0) continue;
-        const double weight = -backflow_beta_ * area / 3.0;
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) {
-            M(tri[i], tri[j]) += weight * inflow * phi[i] * phi[j];
-            if (newton)
-              D.block<3, 3>(4 * tri[i], 4 * tri[j]) +=
-                  weight * phi[i] * phi[j] * a * normal.transpose();
-          }
-      }
-    }
+    Eigen::Matrix<double, 16, 16> D;
+    backflow_face(mesh_, v, advection, backflow_beta_, M, newton ? &D : nullptr);
     if (M.isZero()) return;
     // PETSc reads the (4m)×(4m) block row-major: velocity components on the block diagonal.
     std::array<double, 16 * 16> block{};

@@ -1,5 +1,7 @@
 #include "solver/ns/patch_integrals.h"
 
+#include <array>
+
 namespace naris::ns {
 
 double patch_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u, int patch) {
@@ -9,6 +11,26 @@ double patch_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u,
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (NodeId n : v) mean += u[static_cast<std::size_t>(n)];
     flux += polygon_vector_area(mesh, v).dot(mean) / static_cast<double>(v.size());
+  });
+  return flux;
+}
+
+Eigen::Vector3d patch_momentum_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u,
+                                    int patch) {
+  Eigen::Vector3d flux = Eigen::Vector3d::Zero();
+  for_each_boundary_face(mesh, [&](std::span<const NodeId> v, int id) {
+    if (id != patch) return;
+    const auto at = [&](std::size_t i) -> const Eigen::Vector3d& {
+      return u[static_cast<std::size_t>(v[i])];
+    };
+    // Fan triangles from the first corner, each by its edge midpoints (degree 2).
+    for (std::size_t k = 1; k + 1 < v.size(); ++k) {
+      const std::array<NodeId, 3> tri{v[0], v[k], v[k + 1]};
+      const Eigen::Vector3d an = polygon_vector_area(mesh, tri);
+      const Eigen::Vector3d mid[3] = {(at(0) + at(k)) / 2, (at(k) + at(k + 1)) / 2,
+                                      (at(k + 1) + at(0)) / 2};
+      for (const auto& m : mid) flux += m * m.dot(an) / 3.0;
+    }
   });
   return flux;
 }

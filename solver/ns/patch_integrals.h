@@ -1,6 +1,7 @@
 #pragma once
 // Integrals of nodal fields over a boundary patch, face by face (each face's vector area times
-// the mean of its corner values): the flux through inlets and outlets, mean pressures.
+// the mean of its corner values): the flux through inlets and outlets, mean pressures; the
+// momentum flux by a rule exact for the product of two linear fields.
 #include <vector>
 
 #include "mesh/hybrid_mesh.h"
@@ -9,6 +10,9 @@ namespace naris::ns {
 
 // ∫ u·n dA over the faces of `patch` (n outward).
 double patch_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u, int patch);
+// ∫ u (u·n) dA over the faces of `patch` (n outward): the momentum the flow carries out.
+Eigen::Vector3d patch_momentum_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u,
+                                    int patch);
 // ∫ v dA and the area of the faces of `patch` (summed over ranks, these give the mean).
 struct PatchIntegral {
   double integral = 0.0, area = 0.0;

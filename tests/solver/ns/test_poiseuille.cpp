@@ -17,7 +17,9 @@
 #include "solver/ns/boundary_conditions.h"
 #include "solver/ns/inlet_expression.h"
 #include "solver/ns/patch_integrals.h"
+#include "solver/ns/reaction_force.h"
 #include "solver/ns/wall_stress.h"
+#include "solver/parallel/partition.h"
 #include "tests/solver/meshes.h"
 
 namespace naris::ns {
@@ -92,6 +94,30 @@ void check_poiseuille(double re) {
   EXPECT_GT(axial / shear_area, 0.99 * tau);  // along the flow
   EXPECT_NEAR(out, in, 1e-6 * in);
   EXPECT_NEAR(in, q, 1e-9 * q);
+
+  // The consistent (reaction) force: in developed flow the wall carries the drop of the mean
+  // pressure times the section, and the patches' forces balance the momentum fluxes.
+  const std::vector<Eigen::Vector3d> forces =
+      reaction_forces(mesh, parallel::whole_numbering(mesh.nodes.size()), f,
+                      FlowProblem{re, {}, bc}, airflow_patch_kinds(mesh), PETSC_COMM_WORLD);
+  const int inlet_id = mesh.patch_id("inlet"), outlet_id = mesh.patch_id("outlet");
+  const PatchIntegral p_in = patch_integral(mesh, f.pressure, inlet_id),
+                      p_out = patch_integral(mesh, f.pressure, outlet_id);
+  const double drop_force = (p_in.integral / p_in.area - p_out.integral / p_out.area) * area;
+  const Eigen::Vector3d& on_wall = forces[static_cast<std::size_t>(wall)];
+  const Eigen::Vector3d surface = stress.patches[static_cast<std::size_t>(wall)].pressure +
+                                  stress.patches[static_cast<std::size_t>(wall)].viscous;
+  Eigen::Vector3d balance = patch_momentum_flux(mesh, f.velocity, inlet_id) +
+                            patch_momentum_flux(mesh, f.velocity, outlet_id);
+  for (const auto& force : forces) balance += force;
+  std::printf(
+      "[ info ] Re %g: wall force %.6f (surface integral %.6f) vs dp A %.6f (%.3f%%); momentum "
+      "balance %.2e of the wall force\n",
+      re, on_wall[2], surface[2], drop_force, 100 * (on_wall[2] / drop_force - 1),
+      balance.norm() / on_wall.norm());
+  EXPECT_NEAR(on_wall[2], drop_force, 0.01 * drop_force);
+  EXPECT_LT(std::hypot(on_wall[0], on_wall[1]), 1e-3 * on_wall[2]);
+  EXPECT_LT(balance.norm(), 1e-3 * on_wall.norm());
 }
 
 TEST(Poiseuille, PressureDropAndCentrelineAtLowReynolds) {

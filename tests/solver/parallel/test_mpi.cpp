@@ -6,11 +6,15 @@
 // Ethier–Steinman flow on an MVE ball has every cell type.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
 #include "solver/nonlinear/navier_stokes_solver.h"
+#include "solver/ns/boundary_conditions.h"
+#include "solver/ns/distributed_field.h"
 #include "solver/ns/node_graph.h"
+#include "solver/ns/reaction_force.h"
 #include "solver/parallel/block_assembly.h"
 #include "solver/parallel/partition.h"
 #include "solver/parallel/petsc.h"
@@ -78,6 +82,48 @@ TEST(Mpi, SeveralRanksReachTheSerialSolution) {
   NonlinearReport exact;
   solve_navier_stokes(mesh, problem, options, &exact);
   EXPECT_TRUE(testing::ends_quadratically(exact.residuals));
+}
+
+// The consistent forces summed from the pieces — each rank's cells' residuals and faces, added
+// on the nodes' owners across the ranks' boundary — are the whole mesh's on one rank, for any
+// field (no solve needed), on a pipe whose inlet rim is shared by a prescribed patch and a wall.
+TEST(Mpi, ReactionForcesOfThePiecesAreTheWholeMeshs) {
+  int ranks = 1, rank = 0;
+  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  ASSERT_GE(ranks, 2) << "run this test under mpiexec -n 2";
+  mve::MveOptions options;
+  options.side_patch[4] = "inlet";
+  options.side_patch[5] = "outlet";
+  const HybridMesh whole = testing::mve_mesh_box(
+      [](const Eigen::Vector3d& x) { return 0.5 - std::hypot(x[0] - 0.013, x[1] + 0.007); },
+      {-0.6, -0.6, 0.0}, {0.6, 0.6, 1.5}, 0.1, options);
+  FlowField field;
+  for (const auto& x : whole.nodes) {
+    field.velocity.push_back(testing::beltrami(x));
+    field.pressure.push_back(testing::beltrami_pressure(x));
+  }
+  const FlowProblem problem{100.0, {}, airflow_conditions(whole, InletProfile::uniform, 1.0)};
+  const std::vector<PatchKind> kinds = airflow_patch_kinds(whole);
+  const auto serial = reaction_forces(whole, parallel::whole_numbering(whole.nodes.size()), field,
+                                      problem, kinds, PETSC_COMM_SELF);
+  const auto piece = parallel::mesh_piece(whole, rank, ranks);
+  FlowProblem local = problem;
+  local.conditions = local_conditions(problem.conditions, piece.numbering);
+  const auto shared =
+      reaction_forces(piece.mesh, piece.numbering, local_field(field, piece.numbering), local,
+                      kinds, PETSC_COMM_WORLD);
+  ASSERT_EQ(shared.size(), serial.size());
+  for (std::size_t q = 0; q < serial.size(); ++q) {
+    if (rank == 0)
+      std::printf("[ info ] %s: %.6e %.6e %.6e on one rank, difference %.1e on %d\n",
+                  whole.patch_names[q].c_str(), serial[q][0], serial[q][1], serial[q][2],
+                  (shared[q] - serial[q]).norm(), ranks);
+    EXPECT_LE((shared[q] - serial[q]).norm(), 1e-12 * (1.0 + serial[q].norm()))
+        << whole.patch_names[q];
+  }
+  EXPECT_GT(serial[static_cast<std::size_t>(whole.patch_id("inlet"))].norm(), 0.0);
+  EXPECT_GT(serial[static_cast<std::size_t>(whole.patch_id("wall"))].norm(), 0.0);
 }
 
 // The solver's 4×4-block matrix of type `type` over the piece's owned nodes; every cell the rank

@@ -1,0 +1,205 @@
+#include "solver/ns/reaction_force.h"
+
+#include <petscvec.h>
+
+#include "solver/ns/backflow.h"
+#include "solver/ns/oseen_element.h"
+#include "solver/ns/recovered_gradient.h"
+#include "solver/parallel/petsc.h"
+
+namespace naris::ns {
+namespace {
+
+using petsc::check;
+
+// Per node, summed over the ranks: the reaction R_i (3), then per patch ∫ N_i (1) and the
+// surface integral of the traction σn against N_i (3).
+constexpr int kReaction = 3, kPerPatch = 4;
+
+// Adds the owned cells' momentum residuals at nodes with Dirichlet velocity into `row`.
+template <class E, class Cells>
+void add_cell_residuals(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
+                        const Cells& cells, const FlowField& field,
+                        const std::vector<Eigen::Matrix<double, 1, 9>>& gradient,
+                        const std::vector<char>& fixed, const FlowProblem& problem,
+                        std::vector<double>& rows, int stride) {
+  constexpr int N = E::nodes;
+  const double nu = 1.0 / problem.reynolds;
+  const auto force = [&](const Eigen::Vector3d& x) -> Eigen::Vector3d {
+    return problem.force ? problem.force(x) : Eigen::Vector3d::Zero();
+  };
+  Eigen::Matrix<double, N, 3> X, a;
+  Eigen::Matrix<double, N, 1> p;
+  Eigen::Matrix<double, N, 9> grad;
+  ElementSystem<N> sys;
+  for (const auto& cell : cells) {
+    bool any = false;
+    for (NodeId v : cell) any = any || fixed[static_cast<std::size_t>(v)];
+    if (!any || !numbering.owns_cell(cell)) continue;
+    for (int i = 0; i < N; ++i) {
+      const auto n = static_cast<std::size_t>(cell[static_cast<std::size_t>(i)]);
+      X.row(i) = piece.nodes[n].transpose();
+      a.row(i) = field.velocity[n].transpose();
+      grad.row(i) = gradient[n];
+      p[i] = field.pressure[n];
+    }
+    oseen_element<E>(X, a, &grad, nu, force, sys, p, Linearization::picard_residual);
+    for (int i = 0; i < N; ++i) {
+      const auto n = static_cast<std::size_t>(cell[static_cast<std::size_t>(i)]);
+      if (!fixed[n]) continue;
+      for (int c = 0; c < 3; ++c)
+        rows[n * static_cast<std::size_t>(stride) + static_cast<std::size_t>(c)] +=
+            sys.R[4 * i + c];
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<PatchKind> airflow_patch_kinds(const HybridMesh& mesh) {
+  std::vector<PatchKind> kinds(mesh.patch_names.size(), PatchKind::wall);
+  for (std::size_t q = 0; q < kinds.size(); ++q) {
+    if (mesh.patch_names[q] == "inlet") kinds[q] = PatchKind::prescribed;
+    if (mesh.patch_names[q] == "outlet") kinds[q] = PatchKind::natural;
+  }
+  return kinds;
+}
+
+std::vector<Eigen::Vector3d> reaction_forces(const HybridMesh& piece,
+                                             const parallel::NodeNumbering& numbering,
+                                             const FlowField& field, const FlowProblem& problem,
+                                             const std::vector<PatchKind>& kinds, MPI_Comm comm) {
+  const int patches = static_cast<int>(kinds.size());
+  const int stride = kReaction + kPerPatch * patches;
+  const std::size_t nodes = piece.nodes.size();
+  std::vector<char> fixed(nodes, 0);
+  for (NodeId n : problem.conditions.nodes) fixed[static_cast<std::size_t>(n)] = 1;
+  std::vector<Eigen::Matrix<double, 1, 9>> gradient;
+  std::vector<double> mass;
+  recover_gradient(piece, field.velocity, gradient, mass);
+
+  std::vector<double> rows(nodes * static_cast<std::size_t>(stride), 0.0);
+  add_cell_residuals<fem::Tet4>(piece, numbering, piece.tets, field, gradient, fixed, problem, rows,
+                                stride);
+  add_cell_residuals<fem::Pyr5>(piece, numbering, piece.pyramids, field, gradient, fixed, problem,
+                                rows, stride);
+  add_cell_residuals<fem::Hex8>(piece, numbering, piece.hexes, field, gradient, fixed, problem,
+                                rows, stride);
+  // The piece's boundary faces are the ones this rank owns: ∫ N_i over each, and on prescribed
+  // patches ∫ σn N_i with σn = −p n + ν (∇u) n, the traction of the weak form's Laplacian
+  // viscous term (a triangle's consistent mass, a quadrilateral's lumped).
+  const double nu = 1.0 / problem.reynolds;
+  for_each_boundary_face(piece, [&](std::span<const NodeId> v, int patch) {
+    const Eigen::Vector3d an = polygon_vector_area(piece, v);
+    const double area = an.norm();
+    if (area <= 0.0) return;
+    const Eigen::Vector3d normal = an / area;
+    const int m = static_cast<int>(v.size());
+    Eigen::Vector3d traction[4];
+    for (int j = 0; j < m; ++j) {
+      const auto n = static_cast<std::size_t>(v[static_cast<std::size_t>(j)]);
+      const Eigen::Matrix3d g =
+          Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(gradient[n].data());
+      traction[j] = -field.pressure[n] * normal + nu * g * normal;
+    }
+    const std::size_t base = kReaction + static_cast<std::size_t>(kPerPatch * patch);
+    for (int i = 0; i < m; ++i) {
+      const auto n = static_cast<std::size_t>(v[static_cast<std::size_t>(i)]);
+      double* row = rows.data() + n * static_cast<std::size_t>(stride) + base;
+      if (!fixed[n]) continue;  // the rest carry no reaction
+      row[0] += area / m;
+      if (kinds[static_cast<std::size_t>(patch)] != PatchKind::prescribed) continue;
+      Eigen::Vector3d s = Eigen::Vector3d::Zero();
+      if (m == 3)
+        for (int j = 0; j < 3; ++j) s += area / 12.0 * (i == j ? 2.0 : 1.0) * traction[j];
+      else
+        s = area / m * traction[i];
+      for (int c = 0; c < 3; ++c) row[1 + c] += s[c];
+    }
+  });
+
+  // The outflow stabilization's term B_i (backflow.h) is the outlet's traction on the fluid,
+  // −B_i against N_i: the outlet bears Σ B_i, and a wall node on its rim R_i + B_i.
+  std::vector<double> force(3 * static_cast<std::size_t>(patches), 0.0);
+  if (problem.backflow.patch >= 0) {
+    Eigen::Matrix4d M;
+    for_each_boundary_face(piece, [&](std::span<const NodeId> v, int patch) {
+      if (patch != problem.backflow.patch) return;
+      backflow_face(piece, v, field.velocity, problem.backflow.beta, M, nullptr);
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        Eigen::Vector3d b = Eigen::Vector3d::Zero();
+        for (std::size_t j = 0; j < v.size(); ++j)
+          b += M(static_cast<int>(i), static_cast<int>(j)) *
+               field.velocity[static_cast<std::size_t>(v[j])];
+        for (int c = 0; c < 3; ++c) force[3 * static_cast<std::size_t>(patch) + c] += b[c];
+        const auto n = static_cast<std::size_t>(v[i]);
+        if (fixed[n])
+          for (int c = 0; c < 3; ++c) rows[n * static_cast<std::size_t>(stride) + c] += b[c];
+      }
+    });
+  }
+
+  // The rows summed on their owners.
+  petsc::Vector sums;
+  check(VecCreate(comm, sums.out()), "VecCreate");
+  check(VecSetSizes(sums, stride * static_cast<PetscInt>(numbering.owned), PETSC_DETERMINE),
+        "VecSetSizes");
+  check(VecSetBlockSize(sums, stride), "VecSetBlockSize");
+  check(VecSetType(sums, VECMPI), "VecSetType");
+  check(VecSet(sums, 0.0), "VecSet");
+  for (std::size_t n = 0; n < nodes; ++n) {
+    if (!fixed[n]) continue;
+    const PetscInt block = numbering.to_global(static_cast<NodeId>(n));
+    check(VecSetValuesBlocked(sums, 1, &block, rows.data() + n * static_cast<std::size_t>(stride),
+                              ADD_VALUES),
+          "VecSetValuesBlocked");
+  }
+  check(VecAssemblyBegin(sums), "VecAssemblyBegin");
+  check(VecAssemblyEnd(sums), "VecAssemblyEnd");
+
+  const PetscScalar* all = nullptr;
+  check(VecGetArrayRead(sums, &all), "VecGetArrayRead");
+  std::vector<double> share(static_cast<std::size_t>(patches));
+  for (NodeId k = 0; k < numbering.owned; ++k) {
+    const double* row = all + static_cast<std::size_t>(k) * static_cast<std::size_t>(stride);
+    const auto mass_of = [&](int q) { return row[kReaction + kPerPatch * q]; };
+    Eigen::Vector3d rest(row[0], row[1], row[2]);
+    double wall_mass = 0.0, prescribed_mass = 0.0;
+    for (int q = 0; q < patches; ++q) {
+      if (mass_of(q) <= 0.0) continue;
+      if (kinds[static_cast<std::size_t>(q)] == PatchKind::wall) wall_mass += mass_of(q);
+      if (kinds[static_cast<std::size_t>(q)] == PatchKind::prescribed)
+        prescribed_mass += mass_of(q);
+    }
+    if (wall_mass + prescribed_mass <= 0.0) continue;  // inside the domain: no boundary's force
+    // Prescribed patches take their traction's integral where walls share the node; alone
+    // they share the reaction by area (natural patches carry none).
+    for (int q = 0; q < patches; ++q) {
+      if (mass_of(q) <= 0.0 || kinds[static_cast<std::size_t>(q)] != PatchKind::prescribed)
+        continue;
+      Eigen::Vector3d part;
+      if (wall_mass > 0.0) {
+        const double* s = row + kReaction + kPerPatch * q + 1;
+        part = Eigen::Vector3d(s[0], s[1], s[2]);
+      } else {
+        part = Eigen::Vector3d(row[0], row[1], row[2]) * (mass_of(q) / prescribed_mass);
+      }
+      rest -= part;
+      for (int c = 0; c < 3; ++c) force[3 * static_cast<std::size_t>(q) + c] -= part[c];
+    }
+    if (wall_mass <= 0.0) continue;
+    for (int q = 0; q < patches; ++q)
+      if (mass_of(q) > 0.0 && kinds[static_cast<std::size_t>(q)] == PatchKind::wall)
+        for (int c = 0; c < 3; ++c)
+          force[3 * static_cast<std::size_t>(q) + c] -= rest[c] * mass_of(q) / wall_mass;
+  }
+  check(VecRestoreArrayRead(sums, &all), "VecRestoreArrayRead");
+  MPI_Allreduce(MPI_IN_PLACE, force.data(), static_cast<int>(force.size()), MPI_DOUBLE, MPI_SUM,
+                comm);
+  std::vector<Eigen::Vector3d> out(static_cast<std::size_t>(patches));
+  for (int q = 0; q < patches; ++q)
+    out[static_cast<std::size_t>(q)] = {force[3 * q], force[3 * q + 1], force[3 * q + 2]};
+  return out;
+}
+
+}  // namespace naris::ns

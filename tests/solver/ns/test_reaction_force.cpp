@@ -1,0 +1,93 @@
+// The consistent (reaction) force against the surface integral of the cells' gradients: the drag
+// on a sphere in a pipe on three meshes, 6, 8 and 10 cells across the sphere.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "solver/nonlinear/navier_stokes_solver.h"
+#include "solver/ns/boundary_conditions.h"
+#include "solver/ns/patch_integrals.h"
+#include "solver/ns/reaction_force.h"
+#include "solver/ns/wall_stress.h"
+#include "solver/parallel/partition.h"
+#include "tests/solver/meshes.h"
+
+namespace naris::ns {
+namespace {
+
+const Eigen::Vector3d kCentre(0.013, -0.007, 1.0);
+constexpr double kRadius = 0.15;  // the pipe's diameter is 1
+
+// A pipe along z from 0 to 2.5 with a sphere on its axis; the sphere's faces become the
+// patch `body`.
+HybridMesh sphere_in_pipe(double h) {
+  mve::MveOptions options;
+  options.side_patch[4] = "inlet";
+  options.side_patch[5] = "outlet";
+  HybridMesh mesh = testing::mve_mesh_box(
+      [](const Eigen::Vector3d& x) {
+        return std::min(0.5 - std::hypot(x[0] - 0.013, x[1] + 0.007),
+                        (x - kCentre).norm() - kRadius);
+      },
+      {-0.6, -0.6, 0.0}, {0.6, 0.6, 2.5}, h, options);
+  const int wall = mesh.patch_id("wall");
+  const auto body = static_cast<std::int32_t>(mesh.patch_names.size());
+  mesh.patch_names.push_back("body");
+  const auto near_sphere = [&](std::span<const NodeId> v) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (NodeId n : v) c += mesh.nodes[static_cast<std::size_t>(n)];
+    return (c / static_cast<double>(v.size()) - kCentre).norm() < 2 * kRadius;
+  };
+  for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f)
+    if (mesh.boundary_tri_patch[f] == wall && near_sphere(mesh.boundary_tris[f]))
+      mesh.boundary_tri_patch[f] = body;
+  for (std::size_t f = 0; f < mesh.boundary_quads.size(); ++f)
+    if (mesh.boundary_quad_patch[f] == wall && near_sphere(mesh.boundary_quads[f]))
+      mesh.boundary_quad_patch[f] = body;
+  return mesh;
+}
+
+struct Drag {
+  double consistent = 0.0, surface = 0.0, balance = 0.0;
+};
+
+Drag drag_at(int across, double re) {
+  const HybridMesh mesh = sphere_in_pipe(2 * kRadius / across);
+  const DirichletConditions bc = airflow_conditions(mesh, InletProfile::developed, 1.0);
+  nonlinear::NonlinearReport report;
+  const FlowProblem problem{re, {}, bc};
+  const FlowField f = nonlinear::solve_navier_stokes(mesh, problem, {}, &report);
+  EXPECT_TRUE(report.converged) << across << " cells across";
+  const std::vector<Eigen::Vector3d> forces =
+      reaction_forces(mesh, parallel::whole_numbering(mesh.nodes.size()), f, problem,
+                      airflow_patch_kinds(mesh), PETSC_COMM_WORLD);
+  const auto body = static_cast<std::size_t>(mesh.patch_id("body"));
+  const WallStress stress = wall_stress(mesh, f, re);
+  Eigen::Vector3d balance = patch_momentum_flux(mesh, f.velocity, mesh.patch_id("inlet")) +
+                            patch_momentum_flux(mesh, f.velocity, mesh.patch_id("outlet"));
+  for (const auto& force : forces) balance += force;
+  const Drag d{forces[body][2], stress.patches[body].pressure[2] + stress.patches[body].viscous[2],
+               balance.norm() / forces[body].norm()};
+  std::printf(
+      "[ info ] %2d cells across the sphere, %zu cells: drag %.6f consistent, %.6f surface "
+      "integral; momentum balance %.1e of the drag\n",
+      across, mesh.cell_count(), d.consistent, d.surface, d.balance);
+  return d;
+}
+
+// The consistent drag changes monotonically with shrinking steps under refinement, and the
+// patches' forces close the momentum balance.
+TEST(ReactionForce, DragOnASphereInAPipeConvergesMonotonically) {
+  const double re = 20.0;  // on the pipe's diameter and mean speed
+  const Drag coarse = drag_at(6, re), middle = drag_at(8, re), fine = drag_at(10, re);
+  const double first = middle.consistent - coarse.consistent,
+               second = fine.consistent - middle.consistent;
+  EXPECT_GT(first * second, 0.0) << "not monotonic";
+  EXPECT_LT(std::abs(second), std::abs(first));
+  for (const Drag& d : {coarse, middle, fine}) EXPECT_LT(d.balance, 1e-3);
+}
+
+}  // namespace
+}  // namespace naris::ns
