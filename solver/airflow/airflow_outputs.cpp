@@ -95,10 +95,30 @@ std::vector<Eigen::Vector3d> gather_face_shear(const std::vector<Eigen::Vector3d
   return whole;
 }
 
-// The flow's numbers in SI into r; the wall stress of every boundary face (gathered on the
-// first rank), in units of ρU_in².
-ns::WallStress flow_results(const AirflowJob& job, const Partition& part, const PieceSolves& solves,
-                            const ns::FlowField& field, AirflowResult& r) {
+// The wall shear stress of every boundary face (on the first rank), in units of ρU_in²: from the
+// consistent traction, and from the near-wall cells' gradients to compare.
+struct BoundaryShear {
+  std::vector<Eigen::Vector3d> consistent, cell;
+};
+
+// Per patch, the area-weighted mean and the largest |τ_w| of `shear` over the piece's faces.
+void patch_shear(const HybridMesh& piece, const std::vector<Eigen::Vector3d>& shear,
+                 std::vector<PatchForce>& patches) {
+  for (auto& p : patches) p.mean_shear = p.max_shear = 0.0;
+  std::size_t f = 0;
+  for_each_boundary_face(piece, [&](std::span<const NodeId> v, int patch) {
+    PatchForce& p = patches[static_cast<std::size_t>(patch)];
+    const double s = shear[f++].norm();
+    p.mean_shear += polygon_area(piece, v) * s;
+    p.max_shear = std::max(p.max_shear, s);
+  });
+  for (auto& p : patches)
+    if (p.area > 0.0) p.mean_shear /= p.area;
+}
+
+// The flow's numbers in SI into r, and the wall shear stress.
+BoundaryShear flow_results(const AirflowJob& job, const Partition& part, const PieceSolves& solves,
+                           const ns::FlowField& field, AirflowResult& r) {
   const double u = r.u_in, pscale = job.density * u * u;
   r.flow_ml_s = u * r.inlet_area_mm2;  // m/s × mm² = 1e-6 m³/s = mL/s
   r.outlet_flow_ml_s = solves.outlet_flux(field) * u * r.d_in_mm * r.d_in_mm;
@@ -107,17 +127,21 @@ ns::WallStress flow_results(const AirflowJob& job, const Partition& part, const 
   r.max_speed = solves.max_speed(field) * u;
   // Stresses on the boundary, while the geometry is still nondimensional.
   ns::WallStress stress = ns::wall_stress(part.piece.mesh, field, r.reynolds);
+  const ns::Reactions reactions = solves.reaction_forces(field, r.reynolds);
+  const std::vector<Eigen::Vector3d>& forces = reactions.patches;
+  const std::vector<ns::PatchKind> kinds = ns::airflow_patch_kinds(part.piece.mesh);
+  BoundaryShear shear{ns::consistent_wall_shear(part.piece.mesh, reactions, kinds),
+                      std::move(stress.shear)};
+  patch_shear(part.piece.mesh, shear.consistent, stress.patches);
   int ranks = 1;
   MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
   if (ranks > 1) {
     reduce_patch_forces(stress.patches, PETSC_COMM_WORLD);
-    stress.shear = gather_face_shear(stress.shear, part.piece.face_index, part.boundary_faces,
-                                     PETSC_COMM_WORLD, 0);
+    for (auto* s : {&shear.consistent, &shear.cell})
+      *s = gather_face_shear(*s, part.piece.face_index, part.boundary_faces, PETSC_COMM_WORLD, 0);
   }
-  const std::vector<Eigen::Vector3d> forces = solves.reaction_forces(field, r.reynolds);
   Eigen::Vector3d balance = solves.momentum_outflow(field);
   double largest_wall = 0.0;
-  const std::vector<ns::PatchKind> kinds = ns::airflow_patch_kinds(part.piece.mesh);
   for (std::size_t q = 0; q < forces.size(); ++q) {
     balance += forces[q];
     if (kinds[q] == ns::PatchKind::wall) largest_wall = std::max(largest_wall, forces[q].norm());
@@ -130,7 +154,7 @@ ns::WallStress flow_results(const AirflowJob& job, const Partition& part, const 
                          p.pressure * force_scale, p.viscous * force_scale, p.mean_shear * pscale,
                          p.max_shear * pscale});
   }
-  return stress;
+  return shear;
 }
 
 // The volume: one file from a serial run; under MPI a .pvtu whose pieces the ranks write at
@@ -185,16 +209,19 @@ void write_volume(const AirflowJob& job, const Partition& part, const ns::FlowFi
 }
 
 // boundary.vtp with the wall shear stress of every face (first rank).
-void write_boundary(const AirflowJob& job, const Partition& part, const ns::WallStress& stress,
+void write_boundary(const AirflowJob& job, const Partition& part, const BoundaryShear& shear,
                     double pscale, std::vector<std::string>& written) {
   PointFields faces;
-  PointField vec{3, {}}, mag{1, {}};
-  for (const auto& s : stress.shear) {
+  PointField vec{3, {}}, mag{1, {}}, cell{3, {}};
+  for (const auto& s : shear.consistent) {
     for (int c = 0; c < 3; ++c) vec.values.push_back(s[c] * pscale);
     mag.values.push_back(s.norm() * pscale);
   }
+  for (const auto& s : shear.cell)
+    for (int c = 0; c < 3; ++c) cell.values.push_back(s[c] * pscale);
   faces["wall_shear_stress"] = std::move(vec);
   faces["wall_shear_stress_magnitude"] = std::move(mag);
+  faces["wall_shear_stress_cell"] = std::move(cell);
   const fs::path vtp = job.output / "boundary.vtp";
   int ranks = 1;
   MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
@@ -220,7 +247,7 @@ Partition partition(HybridMesh mesh, int rank, int ranks) {
 
 void write_airflow_outputs(const AirflowJob& job, Partition& part, const PieceSolves& solves,
                            const ns::FlowField& field, AirflowResult& r) {
-  const ns::WallStress stress = flow_results(job, part, solves, field, r);
+  const BoundaryShear shear = flow_results(job, part, solves, field, r);
   // Files, in millimetres again.
   for (auto& x : part.piece.mesh.nodes) x *= r.d_in_mm;
   for (auto& x : part.surface.nodes) x *= r.d_in_mm;
@@ -236,7 +263,7 @@ void write_airflow_outputs(const AirflowJob& job, Partition& part, const PieceSo
   r.total_peak_memory = sum;
   const SolutionState final_state = solves.state_at(field, r.reynolds);  // collective
   if (!solves.writer()) return;
-  write_boundary(job, part, stress, job.density * r.u_in * r.u_in, r.written);
+  write_boundary(job, part, shear, job.density * r.u_in * r.u_in, r.written);
   const fs::path h5 = job.output / "solution.h5";
   write_solution_h5(final_state, h5, &part.counts, job.mesh);
   r.written.push_back(h5.string());

@@ -10,7 +10,6 @@
 #include "solver/nonlinear/navier_stokes_solver.h"
 #include "solver/ns/distributed_field.h"
 #include "solver/ns/patch_integrals.h"
-#include "solver/ns/reaction_force.h"
 
 namespace naris::airflow {
 
@@ -95,8 +94,7 @@ double PieceSolves::outlet_flux(const ns::FlowField& f) const {
   return flux;
 }
 
-std::vector<Eigen::Vector3d> PieceSolves::reaction_forces(const ns::FlowField& f,
-                                                          double reynolds) const {
+ns::Reactions PieceSolves::reaction_forces(const ns::FlowField& f, double reynolds) const {
   ns::FlowProblem problem = problem_;
   problem.reynolds = reynolds;
   return ns::reaction_forces(piece_, numbering_, f, problem, ns::airflow_patch_kinds(piece_),

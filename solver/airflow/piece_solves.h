@@ -9,6 +9,7 @@
 #include "solver/airflow/solution_file.h"
 #include "solver/continuation/reynolds_continuation.h"
 #include "solver/ns/flow_problem.h"
+#include "solver/ns/reaction_force.h"
 #include "solver/parallel/partition.h"
 
 namespace naris::airflow {
@@ -40,10 +41,10 @@ class PieceSolves final : public continuation::SteadySolves {
   double pressure_drop(const ns::FlowField& f) const;
   double max_speed(const ns::FlowField& f) const;
   double outlet_flux(const ns::FlowField& f) const;
-  // Per patch, the force of the fluid at `reynolds` by the consistent method
-  // (ns/reaction_force.h), and the momentum the flow carries out through the inlet and the
+  // The forces of the fluid at `reynolds` by the consistent method (ns/reaction_force.h), and
+  // the momentum the flow carries out through the inlet and the
   // outlet; nondimensional, collective.
-  std::vector<Eigen::Vector3d> reaction_forces(const ns::FlowField& f, double reynolds) const;
+  ns::Reactions reaction_forces(const ns::FlowField& f, double reynolds) const;
   Eigen::Vector3d momentum_outflow(const ns::FlowField& f) const;
   // The state at `reynolds` on the first rank (the others get an empty field). Collective.
   SolutionState state_at(const ns::FlowField& field, double reynolds) const;

@@ -12,8 +12,9 @@ namespace {
 
 using petsc::check;
 
-// Per node, summed over the ranks: the reaction R_i (3), then per patch ∫ N_i (1) and the
-// surface integral of the traction σn against N_i (3).
+// Per node, summed over the ranks: the reaction R_i (3), then per patch ∫ N_i (1) and a known
+// part of the traction σn against N_i (3): on prescribed patches the whole, estimated from the
+// recovered gradient; on walls the pressure's −p n, exact for the discrete pressure.
 constexpr int kReaction = 3, kPerPatch = 4;
 
 // Adds the owned cells' momentum residuals at nodes with Dirichlet velocity into `row`.
@@ -65,10 +66,9 @@ std::vector<PatchKind> airflow_patch_kinds(const HybridMesh& mesh) {
   return kinds;
 }
 
-std::vector<Eigen::Vector3d> reaction_forces(const HybridMesh& piece,
-                                             const parallel::NodeNumbering& numbering,
-                                             const FlowField& field, const FlowProblem& problem,
-                                             const std::vector<PatchKind>& kinds, MPI_Comm comm) {
+Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
+                          const FlowField& field, const FlowProblem& problem,
+                          const std::vector<PatchKind>& kinds, MPI_Comm comm) {
   const int patches = static_cast<int>(kinds.size());
   const int stride = kReaction + kPerPatch * patches;
   const std::size_t nodes = piece.nodes.size();
@@ -108,12 +108,18 @@ std::vector<Eigen::Vector3d> reaction_forces(const HybridMesh& piece,
       double* row = rows.data() + n * static_cast<std::size_t>(stride) + base;
       if (!fixed[n]) continue;  // the rest carry no reaction
       row[0] += area / m;
-      if (kinds[static_cast<std::size_t>(patch)] != PatchKind::prescribed) continue;
+      const PatchKind kind = kinds[static_cast<std::size_t>(patch)];
+      if (kind == PatchKind::natural) continue;
+      const auto part = [&](int j) -> Eigen::Vector3d {
+        if (kind == PatchKind::prescribed) return traction[j];
+        const auto nj = static_cast<std::size_t>(v[static_cast<std::size_t>(j)]);
+        return -field.pressure[nj] * normal;
+      };
       Eigen::Vector3d s = Eigen::Vector3d::Zero();
       if (m == 3)
-        for (int j = 0; j < 3; ++j) s += area / 12.0 * (i == j ? 2.0 : 1.0) * traction[j];
+        for (int j = 0; j < 3; ++j) s += area / 12.0 * (i == j ? 2.0 : 1.0) * part(j);
       else
-        s = area / m * traction[i];
+        s = area / m * part(i);
       for (int c = 0; c < 3; ++c) row[1 + c] += s[c];
     }
   });
@@ -157,9 +163,18 @@ std::vector<Eigen::Vector3d> reaction_forces(const HybridMesh& piece,
   check(VecAssemblyBegin(sums), "VecAssemblyBegin");
   check(VecAssemblyEnd(sums), "VecAssemblyEnd");
 
+  // The walls' viscous traction on the owned nodes, then on every node of the piece.
+  petsc::Vector traction;
+  check(VecCreate(comm, traction.out()), "VecCreate");
+  check(VecSetSizes(traction, 3 * static_cast<PetscInt>(numbering.owned), PETSC_DETERMINE),
+        "VecSetSizes");
+  check(VecSetBlockSize(traction, 3), "VecSetBlockSize");
+  check(VecSetType(traction, VECMPI), "VecSetType");
+  check(VecSet(traction, 0.0), "VecSet");
+  PetscScalar* owned_traction = nullptr;
+  check(VecGetArray(traction, &owned_traction), "VecGetArray");
   const PetscScalar* all = nullptr;
   check(VecGetArrayRead(sums, &all), "VecGetArrayRead");
-  std::vector<double> share(static_cast<std::size_t>(patches));
   for (NodeId k = 0; k < numbering.owned; ++k) {
     const double* row = all + static_cast<std::size_t>(k) * static_cast<std::size_t>(stride);
     const auto mass_of = [&](int q) { return row[kReaction + kPerPatch * q]; };
@@ -188,18 +203,69 @@ std::vector<Eigen::Vector3d> reaction_forces(const HybridMesh& piece,
       for (int c = 0; c < 3; ++c) force[3 * static_cast<std::size_t>(q) + c] -= part[c];
     }
     if (wall_mass <= 0.0) continue;
+    // The walls' reaction less their pressure part: the viscous traction.
+    Eigen::Vector3d viscous = rest;
+    for (int q = 0; q < patches; ++q)
+      if (mass_of(q) > 0.0 && kinds[static_cast<std::size_t>(q)] == PatchKind::wall)
+        viscous -= Eigen::Map<const Eigen::Vector3d>(row + kReaction + kPerPatch * q + 1);
+    for (int c = 0; c < 3; ++c)
+      owned_traction[3 * static_cast<std::size_t>(k) + static_cast<std::size_t>(c)] =
+          -viscous[c] / wall_mass;
     for (int q = 0; q < patches; ++q)
       if (mass_of(q) > 0.0 && kinds[static_cast<std::size_t>(q)] == PatchKind::wall)
         for (int c = 0; c < 3; ++c)
           force[3 * static_cast<std::size_t>(q) + c] -= rest[c] * mass_of(q) / wall_mass;
   }
   check(VecRestoreArrayRead(sums, &all), "VecRestoreArrayRead");
+  check(VecRestoreArray(traction, &owned_traction), "VecRestoreArray");
   MPI_Allreduce(MPI_IN_PLACE, force.data(), static_cast<int>(force.size()), MPI_DOUBLE, MPI_SUM,
                 comm);
-  std::vector<Eigen::Vector3d> out(static_cast<std::size_t>(patches));
+  Reactions out;
+  out.patches.resize(static_cast<std::size_t>(patches));
   for (int q = 0; q < patches; ++q)
-    out[static_cast<std::size_t>(q)] = {force[3 * q], force[3 * q + 1], force[3 * q + 2]};
+    out.patches[static_cast<std::size_t>(q)] = {force[3 * q], force[3 * q + 1], force[3 * q + 2]};
+
+  std::vector<PetscInt> global(nodes);
+  for (std::size_t n = 0; n < nodes; ++n) global[n] = numbering.to_global(static_cast<NodeId>(n));
+  petsc::IndexSet wanted;
+  check(ISCreateBlock(PETSC_COMM_SELF, 3, static_cast<PetscInt>(nodes), global.data(),
+                      PETSC_COPY_VALUES, wanted.out()),
+        "ISCreateBlock");
+  petsc::Vector local;
+  check(VecCreateSeq(PETSC_COMM_SELF, 3 * static_cast<PetscInt>(nodes), local.out()),
+        "VecCreateSeq");
+  petsc::Scatter scatter;
+  check(VecScatterCreate(traction, wanted, local, nullptr, scatter.out()), "VecScatterCreate");
+  check(VecScatterBegin(scatter, traction, local, INSERT_VALUES, SCATTER_FORWARD),
+        "VecScatterBegin");
+  check(VecScatterEnd(scatter, traction, local, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+  const PetscScalar* t = nullptr;
+  check(VecGetArrayRead(local, &t), "VecGetArrayRead");
+  out.viscous_traction.resize(nodes);
+  for (std::size_t n = 0; n < nodes; ++n)
+    out.viscous_traction[n] = {t[3 * n], t[3 * n + 1], t[3 * n + 2]};
+  check(VecRestoreArrayRead(local, &t), "VecRestoreArrayRead");
   return out;
+}
+
+std::vector<Eigen::Vector3d> consistent_wall_shear(const HybridMesh& piece,
+                                                   const Reactions& reactions,
+                                                   const std::vector<PatchKind>& kinds) {
+  std::vector<Eigen::Vector3d> shear;
+  shear.reserve(piece.boundary_tris.size() + piece.boundary_quads.size());
+  for_each_boundary_face(piece, [&](std::span<const NodeId> v, int patch) {
+    const Eigen::Vector3d an = polygon_vector_area(piece, v);
+    if (kinds[static_cast<std::size_t>(patch)] != PatchKind::wall || !(an.norm() > 0.0)) {
+      shear.push_back(Eigen::Vector3d::Zero());
+      return;
+    }
+    const Eigen::Vector3d n = an.normalized();
+    Eigen::Vector3d t = Eigen::Vector3d::Zero();
+    for (NodeId k : v) t += reactions.viscous_traction[static_cast<std::size_t>(k)];
+    t /= static_cast<double>(v.size());
+    shear.push_back(t - t.dot(n) * n);
+  });
+  return shear;
 }
 
 }  // namespace naris::ns

@@ -26,15 +26,30 @@ enum class PatchKind {
 // every other patch a wall.
 std::vector<PatchKind> airflow_patch_kinds(const HybridMesh& mesh);
 
-// Per patch id, the nondimensional force (units ρU²d²) the fluid exerts on the patch, summed
-// over the ranks of `comm` and known on every rank. `field` and `problem` are the piece's
-// (local numbers, its Dirichlet conditions); a node shared by patches gives a prescribed
-// patch the surface integral of the traction against its basis function there, a natural
-// patch nothing but the outflow stabilization's traction (`problem.backflow`), and the walls
-// the rest, in proportion to ∫ N_i over each. Collective.
-std::vector<Eigen::Vector3d> reaction_forces(const HybridMesh& piece,
-                                             const parallel::NodeNumbering& numbering,
-                                             const FlowField& field, const FlowProblem& problem,
-                                             const std::vector<PatchKind>& kinds, MPI_Comm comm);
+struct Reactions {
+  // Per patch id, the nondimensional force (units ρU²d²) the fluid exerts on the patch, summed
+  // over the ranks and known on every rank.
+  std::vector<Eigen::Vector3d> patches;
+  // Per node of the piece, the viscous force per area the fluid exerts on the walls there: the
+  // walls' share of the reaction less the pressure's ∫ p n N_i, over their ∫ N_i (units ρU²);
+  // zero off the walls.
+  std::vector<Eigen::Vector3d> viscous_traction;
+};
+
+// The reactions of the converged field; the forces are summed over the ranks of `comm`. `field` and
+// `problem` are the piece's (local numbers, its Dirichlet conditions); a node shared by patches
+// gives a prescribed patch the surface integral of the traction against its basis function there, a
+// natural patch nothing but the outflow stabilization's traction (`problem.backflow`), and the
+// walls the rest, in proportion to ∫ N_i over each. Collective.
+Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
+                          const FlowField& field, const FlowProblem& problem,
+                          const std::vector<PatchKind>& kinds, MPI_Comm comm);
+
+// The wall shear stress of the consistent traction, per boundary face of `piece` (triangles,
+// then quadrilaterals, as wall_stress.h): the mean of the face's nodal viscous tractions less
+// its part along the face's normal; zero on faces of patches that are not walls.
+std::vector<Eigen::Vector3d> consistent_wall_shear(const HybridMesh& piece,
+                                                   const Reactions& reactions,
+                                                   const std::vector<PatchKind>& kinds);
 
 }  // namespace naris::ns

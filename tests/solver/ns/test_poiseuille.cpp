@@ -97,9 +97,10 @@ void check_poiseuille(double re) {
 
   // The consistent (reaction) force: in developed flow the wall carries the drop of the mean
   // pressure times the section, and the patches' forces balance the momentum fluxes.
-  const std::vector<Eigen::Vector3d> forces =
+  const Reactions reactions =
       reaction_forces(mesh, parallel::whole_numbering(mesh.nodes.size()), f,
                       FlowProblem{re, {}, bc}, airflow_patch_kinds(mesh), PETSC_COMM_WORLD);
+  const std::vector<Eigen::Vector3d>& forces = reactions.patches;
   const int inlet_id = mesh.patch_id("inlet"), outlet_id = mesh.patch_id("outlet");
   const PatchIntegral p_in = patch_integral(mesh, f.pressure, inlet_id),
                       p_out = patch_integral(mesh, f.pressure, outlet_id);
@@ -118,6 +119,32 @@ void check_poiseuille(double re) {
   EXPECT_NEAR(on_wall[2], drop_force, 0.01 * drop_force);
   EXPECT_LT(std::hypot(on_wall[0], on_wall[1]), 1e-3 * on_wall[2]);
   EXPECT_LT(balance.norm(), 1e-3 * on_wall.norm());
+  // The wall shear of the consistent traction in the developed region: there the wall of any
+  // section carries the pressure gradient, τ_w P = A (−dp/dz), with the meshed section's A and
+  // perimeter P (the wall's area over its length) — exact for the faceted pipe, where 4νU/R is
+  // not.
+  const std::vector<Eigen::Vector3d> consistent =
+      consistent_wall_shear(mesh, reactions, airflow_patch_kinds(mesh));
+  double consistent_shear = 0.0, consistent_axial = 0.0, consistent_area = 0.0;
+  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t) {
+    if (mesh.boundary_tri_patch[t] != wall) continue;
+    const auto& v = mesh.boundary_tris[t];
+    const Eigen::Vector3d c = (mesh.nodes[v[0]] + mesh.nodes[v[1]] + mesh.nodes[v[2]]) / 3.0;
+    if (c[2] < 1.0 || c[2] > 3.0) continue;
+    const double a = polygon_area(mesh, v);
+    consistent_shear += a * consistent[t].norm();
+    consistent_axial += a * consistent[t][2];
+    consistent_area += a;
+  }
+  consistent_shear /= consistent_area;
+  const double section_balance = area / (consistent_area / 2.0) * gradient;
+  std::printf(
+      "[ info ] Re %g: consistent wall shear %.5f vs A/P (-dp/dz) %.5f (%.2f%%), 4 nu U/R %.5f "
+      "(%.2f%%)\n",
+      re, consistent_shear, section_balance, 100 * (consistent_shear / section_balance - 1),
+      exact_tau, 100 * (consistent_shear / exact_tau - 1));
+  EXPECT_NEAR(consistent_shear, section_balance, 0.01 * section_balance);
+  EXPECT_GT(consistent_axial / consistent_area, 0.99 * consistent_shear);
 }
 
 TEST(Poiseuille, PressureDropAndCentrelineAtLowReynolds) {

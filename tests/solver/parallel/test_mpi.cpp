@@ -105,15 +105,27 @@ TEST(Mpi, ReactionForcesOfThePiecesAreTheWholeMeshs) {
   }
   const FlowProblem problem{100.0, {}, airflow_conditions(whole, InletProfile::uniform, 1.0)};
   const std::vector<PatchKind> kinds = airflow_patch_kinds(whole);
-  const auto serial = reaction_forces(whole, parallel::whole_numbering(whole.nodes.size()), field,
-                                      problem, kinds, PETSC_COMM_SELF);
+  const Reactions whole_reactions = reaction_forces(
+      whole, parallel::whole_numbering(whole.nodes.size()), field, problem, kinds, PETSC_COMM_SELF);
+  const std::vector<Eigen::Vector3d>& serial = whole_reactions.patches;
   const auto piece = parallel::mesh_piece(whole, rank, ranks);
   FlowProblem local = problem;
   local.conditions = local_conditions(problem.conditions, piece.numbering);
-  const auto shared =
+  const Reactions piece_reactions =
       reaction_forces(piece.mesh, piece.numbering, local_field(field, piece.numbering), local,
                       kinds, PETSC_COMM_WORLD);
+  const std::vector<Eigen::Vector3d>& shared = piece_reactions.patches;
   ASSERT_EQ(shared.size(), serial.size());
+  // The walls' traction at every node of the piece, halo included.
+  double largest = 0.0, difference = 0.0;
+  for (std::size_t n = 0; n < piece.mesh.nodes.size(); ++n) {
+    const auto g = static_cast<std::size_t>(piece.numbering.to_global(static_cast<NodeId>(n)));
+    largest = std::max(largest, whole_reactions.viscous_traction[g].norm());
+    difference = std::max(
+        difference, (piece_reactions.viscous_traction[n] - whole_reactions.viscous_traction[g]).norm());
+  }
+  EXPECT_GT(largest, 0.0);
+  EXPECT_LE(difference, 1e-12 * largest);
   for (std::size_t q = 0; q < serial.size(); ++q) {
     if (rank == 0)
       std::printf("[ info ] %s: %.6e %.6e %.6e on one rank, difference %.1e on %d\n",
