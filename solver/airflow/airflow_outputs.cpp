@@ -277,6 +277,17 @@ void write_airflow_outputs(const AirflowJob& job, Partition& part, const PieceSo
   r.peak_memory = std::max(r.peak_memory, own);
 }
 
+namespace {
+
+// All ranks' peak memory over the unknowns, four per node.
+double bytes_per_unknown(const AirflowResult& r) {
+  return r.nodes > 0
+             ? static_cast<double>(r.total_peak_memory) / (4.0 * static_cast<double>(r.nodes))
+             : 0.0;
+}
+
+}  // namespace
+
 void write_summary_json(const AirflowJob& job, AirflowResult& r) {
   Json patches = Json::array(), steps = Json::array();
   for (const auto& p : r.patches) {
@@ -328,7 +339,8 @@ void write_summary_json(const AirflowJob& job, AirflowResult& r) {
       {"mpi_ranks", r.ranks},
       {"seconds", significant(r.seconds)},
       {"peak_memory_mb", significant(megabytes(r.peak_memory), 5)},
-      {"peak_memory_all_ranks_mb", significant(megabytes(r.total_peak_memory), 5)}};
+      {"peak_memory_all_ranks_mb", significant(megabytes(r.total_peak_memory), 5)},
+      {"peak_bytes_per_unknown", significant(bytes_per_unknown(r), 4)}};
   const fs::path json = job.output / "summary.json";
   write_json_file(json, summary);
   r.written.push_back(json.string());
@@ -350,7 +362,8 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
       "  speed     max {:.3f} m/s\n"
       "  wall      shear stress mean {:.4f} Pa, max {:.4f} Pa; force {:.3e} N (surface "
       "integral {:.3e} N); momentum balance {:.1e}\n"
-      "  solve     {} continuation steps, {} nonlinear steps, {:.1f} s, peak {}\n"
+      "  solve     {} continuation steps, {} nonlinear steps, {:.1f} s, peak {} ({:.0f} bytes "
+      "per unknown)\n"
       "  wrote     {}",
       job.mesh.filename().string(), r.cells, r.nodes, r.inlet_area_mm2, r.inlet_perimeter_mm,
       r.d_in_mm, profile_name(job), r.reynolds, r.u_in, job.viscosity, job.density, r.flow_ml_s,
@@ -360,7 +373,7 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
       r.ranks > 1 ? fmt::format("{:.0f} MB per rank, {:.0f} MB on {} ranks",
                                 megabytes(r.peak_memory), megabytes(r.total_peak_memory), r.ranks)
                   : fmt::format("{:.0f} MB", megabytes(r.peak_memory)),
-      fmt::join(r.written, "\n            "));
+      bytes_per_unknown(r), fmt::join(r.written, "\n            "));
 }
 
 }  // namespace naris::airflow

@@ -21,7 +21,7 @@ seconds() { /usr/bin/time -f "%e %M" -o "$1" "${@:2}"; }
 elapsed() { tail -1 "$1" | awk '{print $1}'; }
 field() { sed -n "s/.*\"$2\": \\([-0-9.e+]*\\).*/\\1/p" "$1" | head -1; }
 
-declare -A time dp steps memory
+declare -A time dp steps memory per_unknown balance
 for ranks in 1 2; do
   out="$work/naris-$ranks"
   echo "naris solve, $ranks rank(s), Re $re ..." >&2
@@ -38,6 +38,8 @@ for ranks in 1 2; do
     -v all="$(field "$out/summary.json" peak_memory_all_ranks_mb)" -v n="$ranks" \
     'BEGIN { if (m == "") print "?"; else if (n > 1) printf "%.0f/rank, %.0f", m, all;
              else printf "%.0f", m }')
+  per_unknown[$ranks]=$(field "$out/summary.json" peak_bytes_per_unknown)
+  balance[$ranks]=$(field "$out/summary.json" momentum_balance)
   steps[$ranks]=$(grep -o 'nonlinear_iterations": [0-9]*' "$out/summary.json" 2>/dev/null |
     awk '{s += $2} END {print s + 0}')
 done
@@ -62,6 +64,8 @@ printf '%-22s %10s %12s %20s   %s\n' "simpleFoam, 1 core" "${foam_settled_time:-
   "${memory[openfoam]}" "$foam_settled SIMPLE (Δp within 0.1 % from there on)"
 echo "  simpleFoam ran $foam_iterations iterations in ${time[openfoam]} s, stopped after its Δp had" \
   "held for $foam_settle_window; $foam_converged; last $foam_residuals"
+echo "  naris: ${per_unknown[1]} and ${per_unknown[2]} bytes per unknown (1 and 2 ranks, all ranks);" \
+  "momentum balance of the consistent forces ${balance[1]} of the wall force"
 awk -v a="${foam_settled_time:-nan}" -v b="${time[1]}" -v c="${time[2]}" -v p="${dp[1]}" \
   -v q="${dp[openfoam]}" 'BEGIN {
     printf "simpleFoam / naris (1 rank): %.2f;  naris 1 rank / 2 ranks: %.2f;  Δp naris vs simpleFoam: %+.1f %%\n",
