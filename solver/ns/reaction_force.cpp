@@ -85,9 +85,9 @@ Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering
                                 rows, stride);
   add_cell_residuals<fem::Hex8>(piece, numbering, piece.hexes, field, gradient, fixed, problem,
                                 rows, stride);
-  // The piece's boundary faces are the ones this rank owns: ∫ N_i over each, and on prescribed
+  // The piece's boundary faces are the ones this rank owns: ∫ N_i over each; on prescribed
   // patches ∫ σn N_i with σn = −p n + ν (∇u) n, the traction of the weak form's Laplacian
-  // viscous term (a triangle's consistent mass, a quadrilateral's lumped).
+  // viscous term; on walls ∫ −p n N_i (a triangle's consistent mass, a quadrilateral's lumped).
   const double nu = 1.0 / problem.reynolds;
   for_each_boundary_face(piece, [&](std::span<const NodeId> v, int patch) {
     const Eigen::Vector3d an = polygon_vector_area(piece, v);
