@@ -2,6 +2,8 @@
 
 #include <petscvec.h>
 
+#include <cstdlib>
+
 #include "solver/ns/backflow.h"
 #include "solver/ns/oseen_element.h"
 #include "solver/ns/recovered_gradient.h"
@@ -87,7 +89,8 @@ Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering
                                 rows, stride);
   // The piece's boundary faces are the ones this rank owns: ∫ N_i over each; on prescribed
   // patches ∫ σn N_i with σn = −p n + ν (∇u) n, the traction of the weak form's Laplacian
-  // viscous term; on walls ∫ −p n N_i (a triangle's consistent mass, a quadrilateral's lumped).
+  // viscous term; on walls ∫ −p n N_i (the consistent mass of a flat triangle or
+  // parallelogram: exact for the nodal pressure).
   const double nu = 1.0 / problem.reynolds;
   for_each_boundary_face(piece, [&](std::span<const NodeId> v, int patch) {
     const Eigen::Vector3d an = polygon_vector_area(piece, v);
@@ -116,10 +119,15 @@ Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering
         return -field.pressure[nj] * normal;
       };
       Eigen::Vector3d s = Eigen::Vector3d::Zero();
-      if (m == 3)
-        for (int j = 0; j < 3; ++j) s += area / 12.0 * (i == j ? 2.0 : 1.0) * part(j);
-      else
-        s = area / m * part(i);
+      for (int j = 0; j < m; ++j) {
+        const int apart = std::abs(i - j);  // quadrilateral: 2 is the opposite corner
+        s += (m == 3 ? area / 12.0 * (apart == 0 ? 2.0 : 1.0)
+                     : area / 36.0 *
+                           (apart == 0   ? 4.0
+                            : apart == 2 ? 1.0
+                                         : 2.0)) *
+             part(j);
+      }
       for (int c = 0; c < 3; ++c) row[1 + c] += s[c];
     }
   });

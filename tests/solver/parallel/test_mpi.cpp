@@ -103,7 +103,12 @@ TEST(Mpi, ReactionForcesOfThePiecesAreTheWholeMeshs) {
     field.velocity.push_back(testing::beltrami(x));
     field.pressure.push_back(testing::beltrami_pressure(x));
   }
-  const FlowProblem problem{100.0, {}, airflow_conditions(whole, InletProfile::uniform, 1.0)};
+  // The Beltrami field flows back in through parts of the outlet: the outflow stabilization's
+  // traction is counted there.
+  const FlowProblem problem{100.0,
+                            {},
+                            airflow_conditions(whole, InletProfile::uniform, 1.0),
+                            {whole.patch_id("outlet"), 1.0}};
   const std::vector<PatchKind> kinds = airflow_patch_kinds(whole);
   const Reactions whole_reactions = reaction_forces(
       whole, parallel::whole_numbering(whole.nodes.size()), field, problem, kinds, PETSC_COMM_SELF);
@@ -122,7 +127,8 @@ TEST(Mpi, ReactionForcesOfThePiecesAreTheWholeMeshs) {
     const auto g = static_cast<std::size_t>(piece.numbering.to_global(static_cast<NodeId>(n)));
     largest = std::max(largest, whole_reactions.viscous_traction[g].norm());
     difference = std::max(
-        difference, (piece_reactions.viscous_traction[n] - whole_reactions.viscous_traction[g]).norm());
+        difference,
+        (piece_reactions.viscous_traction[n] - whole_reactions.viscous_traction[g]).norm());
   }
   EXPECT_GT(largest, 0.0);
   EXPECT_LE(difference, 1e-12 * largest);
@@ -134,8 +140,7 @@ TEST(Mpi, ReactionForcesOfThePiecesAreTheWholeMeshs) {
     EXPECT_LE((shared[q] - serial[q]).norm(), 1e-12 * (1.0 + serial[q].norm()))
         << whole.patch_names[q];
   }
-  EXPECT_GT(serial[static_cast<std::size_t>(whole.patch_id("inlet"))].norm(), 0.0);
-  EXPECT_GT(serial[static_cast<std::size_t>(whole.patch_id("wall"))].norm(), 0.0);
+  EXPECT_GT(serial[static_cast<std::size_t>(whole.patch_id("outlet"))].norm(), 0.0);
 }
 
 // The solver's 4×4-block matrix of type `type` over the piece's owned nodes; every cell the rank
