@@ -98,26 +98,25 @@ Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering
     if (area <= 0.0) return;
     const Eigen::Vector3d normal = an / area;
     const int m = static_cast<int>(v.size());
-    Eigen::Vector3d traction[4];
-    for (int j = 0; j < m; ++j) {
+    const PatchKind kind = kinds[static_cast<std::size_t>(patch)];
+    // The known traction at the corners: none on natural patches.
+    Eigen::Vector3d known[4];
+    for (int j = 0; j < m && kind != PatchKind::natural; ++j) {
       const auto n = static_cast<std::size_t>(v[static_cast<std::size_t>(j)]);
-      const Eigen::Matrix3d g =
-          Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(gradient[n].data());
-      traction[j] = -field.pressure[n] * normal + nu * g * normal;
+      known[j] = -field.pressure[n] * normal;
+      if (kind == PatchKind::prescribed)
+        known[j] +=
+            nu *
+            Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(gradient[n].data()) *
+            normal;
     }
     const std::size_t base = kReaction + static_cast<std::size_t>(kPerPatch * patch);
     for (int i = 0; i < m; ++i) {
       const auto n = static_cast<std::size_t>(v[static_cast<std::size_t>(i)]);
-      double* row = rows.data() + n * static_cast<std::size_t>(stride) + base;
       if (!fixed[n]) continue;  // the rest carry no reaction
+      double* row = rows.data() + n * static_cast<std::size_t>(stride) + base;
       row[0] += area / m;
-      const PatchKind kind = kinds[static_cast<std::size_t>(patch)];
       if (kind == PatchKind::natural) continue;
-      const auto part = [&](int j) -> Eigen::Vector3d {
-        if (kind == PatchKind::prescribed) return traction[j];
-        const auto nj = static_cast<std::size_t>(v[static_cast<std::size_t>(j)]);
-        return -field.pressure[nj] * normal;
-      };
       Eigen::Vector3d s = Eigen::Vector3d::Zero();
       for (int j = 0; j < m; ++j) {
         const int apart = std::abs(i - j);  // quadrilateral: 2 is the opposite corner
@@ -126,7 +125,7 @@ Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering
                            (apart == 0   ? 4.0
                             : apart == 2 ? 1.0
                                          : 2.0)) *
-             part(j);
+             known[j];
       }
       for (int c = 0; c < 3; ++c) row[1 + c] += s[c];
     }
@@ -211,18 +210,17 @@ Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering
       for (int c = 0; c < 3; ++c) force[3 * static_cast<std::size_t>(q) + c] -= part[c];
     }
     if (wall_mass <= 0.0) continue;
-    // The walls' reaction less their pressure part: the viscous traction.
+    // The walls share the rest by area; less their pressure part it is the viscous traction.
     Eigen::Vector3d viscous = rest;
-    for (int q = 0; q < patches; ++q)
-      if (mass_of(q) > 0.0 && kinds[static_cast<std::size_t>(q)] == PatchKind::wall)
-        viscous -= Eigen::Map<const Eigen::Vector3d>(row + kReaction + kPerPatch * q + 1);
+    for (int q = 0; q < patches; ++q) {
+      if (mass_of(q) <= 0.0 || kinds[static_cast<std::size_t>(q)] != PatchKind::wall) continue;
+      viscous -= Eigen::Map<const Eigen::Vector3d>(row + kReaction + kPerPatch * q + 1);
+      for (int c = 0; c < 3; ++c)
+        force[3 * static_cast<std::size_t>(q) + c] -= rest[c] * mass_of(q) / wall_mass;
+    }
     for (int c = 0; c < 3; ++c)
       owned_traction[3 * static_cast<std::size_t>(k) + static_cast<std::size_t>(c)] =
           -viscous[c] / wall_mass;
-    for (int q = 0; q < patches; ++q)
-      if (mass_of(q) > 0.0 && kinds[static_cast<std::size_t>(q)] == PatchKind::wall)
-        for (int c = 0; c < 3; ++c)
-          force[3 * static_cast<std::size_t>(q) + c] -= rest[c] * mass_of(q) / wall_mass;
   }
   check(VecRestoreArrayRead(sums, &all), "VecRestoreArrayRead");
   check(VecRestoreArray(traction, &owned_traction), "VecRestoreArray");

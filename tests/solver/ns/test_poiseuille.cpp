@@ -41,6 +41,29 @@ HybridMesh pipe(double length) {
       {-0.6, -0.6, 0.0}, {0.6, 0.6, length}, h, options);
 }
 
+// Area-weighted means over the wall faces of the developed region, 1 ≤ z ≤ 3 (length 2), of
+// a per-face shear (boundary triangles first, as wall_stress.h orders them).
+struct DevelopedShear {
+  double magnitude = 0.0, axial = 0.0, wall_area = 0.0;
+};
+DevelopedShear developed_shear(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& shear) {
+  const int wall = mesh.patch_id("wall");
+  DevelopedShear d;
+  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t) {
+    if (mesh.boundary_tri_patch[t] != wall) continue;
+    const auto& v = mesh.boundary_tris[t];
+    const Eigen::Vector3d c = (mesh.nodes[v[0]] + mesh.nodes[v[1]] + mesh.nodes[v[2]]) / 3.0;
+    if (c[2] < 1.0 || c[2] > 3.0) continue;
+    const double a = polygon_area(mesh, v);
+    d.magnitude += a * shear[t].norm();
+    d.axial += a * shear[t][2];
+    d.wall_area += a;
+  }
+  d.magnitude /= d.wall_area;
+  d.axial /= d.wall_area;
+  return d;
+}
+
 void check_poiseuille(double re) {
   const double length = 4.0, nu = 1.0 / re;
   const HybridMesh mesh = pipe(length);
@@ -75,23 +98,13 @@ void check_poiseuille(double re) {
   // first order in h (at h = R/10 about 5 % low), so this checks magnitude and direction.
   const WallStress stress = wall_stress(mesh, f, re);
   const int wall = mesh.patch_id("wall");
-  double shear = 0, shear_area = 0, axial = 0;
-  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t) {
-    if (mesh.boundary_tri_patch[t] != wall) continue;
-    const auto& v = mesh.boundary_tris[t];
-    const Eigen::Vector3d c = (mesh.nodes[v[0]] + mesh.nodes[v[1]] + mesh.nodes[v[2]]) / 3.0;
-    if (c[2] < 1.0 || c[2] > 3.0) continue;
-    const double a = polygon_area(mesh, v);
-    shear += a * stress.shear[t].norm();
-    axial += a * stress.shear[t][2];
-    shear_area += a;
-  }
-  const double tau = shear / shear_area,
+  const DevelopedShear cells = developed_shear(mesh, stress.shear);
+  const double tau = cells.magnitude,
                exact_tau = 4.0 * nu * u_mean / std::sqrt(area / std::numbers::pi);
   std::printf("[ info ] Re %g: wall shear %.5f vs 4 nu U/R %.5f (%.2f%%)\n", re, tau, exact_tau,
               100 * (tau / exact_tau - 1));
   EXPECT_NEAR(tau, exact_tau, 0.06 * exact_tau);
-  EXPECT_GT(axial / shear_area, 0.99 * tau);  // along the flow
+  EXPECT_GT(cells.axial, 0.99 * tau);  // along the flow
   EXPECT_NEAR(out, in, 1e-6 * in);
   EXPECT_NEAR(in, q, 1e-9 * q);
 
@@ -123,28 +136,17 @@ void check_poiseuille(double re) {
   // section carries the pressure gradient, τ_w P = A (−dp/dz), with the meshed section's A and
   // perimeter P (the wall's area over its length) — exact for the faceted pipe, where 4νU/R is
   // not.
-  const std::vector<Eigen::Vector3d> consistent =
-      consistent_wall_shear(mesh, reactions, airflow_patch_kinds(mesh));
-  double consistent_shear = 0.0, consistent_axial = 0.0, consistent_area = 0.0;
-  for (std::size_t t = 0; t < mesh.boundary_tris.size(); ++t) {
-    if (mesh.boundary_tri_patch[t] != wall) continue;
-    const auto& v = mesh.boundary_tris[t];
-    const Eigen::Vector3d c = (mesh.nodes[v[0]] + mesh.nodes[v[1]] + mesh.nodes[v[2]]) / 3.0;
-    if (c[2] < 1.0 || c[2] > 3.0) continue;
-    const double a = polygon_area(mesh, v);
-    consistent_shear += a * consistent[t].norm();
-    consistent_axial += a * consistent[t][2];
-    consistent_area += a;
-  }
-  consistent_shear /= consistent_area;
-  const double section_balance = area / (consistent_area / 2.0) * gradient;
+  const DevelopedShear consistent =
+      developed_shear(mesh, consistent_wall_shear(mesh, reactions, airflow_patch_kinds(mesh)));
+  const double consistent_shear = consistent.magnitude;
+  const double section_balance = area / (consistent.wall_area / 2.0) * gradient;
   std::printf(
       "[ info ] Re %g: consistent wall shear %.5f vs A/P (-dp/dz) %.5f (%.2f%%), 4 nu U/R %.5f "
       "(%.2f%%)\n",
       re, consistent_shear, section_balance, 100 * (consistent_shear / section_balance - 1),
       exact_tau, 100 * (consistent_shear / exact_tau - 1));
   EXPECT_NEAR(consistent_shear, section_balance, 0.01 * section_balance);
-  EXPECT_GT(consistent_axial / consistent_area, 0.99 * consistent_shear);
+  EXPECT_GT(consistent.axial, 0.99 * consistent_shear);
 }
 
 TEST(Poiseuille, PressureDropAndCentrelineAtLowReynolds) {
