@@ -224,7 +224,8 @@ CompareResult run_compare_job(const CompareJob& job) {
       const airflow::SolvedMesh solved =
           airflow::attach_mesh(std::move(s.solution_state), s.results / "solution" / "solution.h5");
       const double voxel = planes::voxel_size(solved.mesh);
-      const planes::SectionCutter cutter(solved.mesh, solved.velocity, voxel);
+      const planes::SectionCutter cutter(solved.mesh, solved.velocity,
+                                         planes::subgrid_velocity(solved), voxel);
       const Json& p = s.planes["planes"][static_cast<std::size_t>(job.plane - 1)];
       SectionPlane plane{vector_of(p["point_mm"]), vector_of(p["normal"]),
                          p["label"].get<std::string>(), p.value("distance_mm", 0.0),

@@ -22,6 +22,7 @@
 
 #include "core/error.h"
 #include "core/units.h"
+#include "solver/ns/subgrid_velocity.h"
 
 namespace naris::planes {
 namespace {
@@ -41,14 +42,23 @@ vtkSmartPointer<vtkDoubleArray> scalar_array(const char* name, vtkIdType n) {
   return a;
 }
 
-// The integral of the point array `name` over a polygonal dataset (0 when it is empty).
-double integrate(vtkPolyData* data, const char* name) {
+// The integrals of the point array axial_velocity and the cell array subgrid_axial_velocity
+// (0 when absent) from vtkIntegrateAttributes's output.
+double integrated_axial(vtkUnstructuredGrid* sums) {
+  return sums->GetPointData()->GetArray("axial_velocity")->GetTuple1(0);
+}
+double integrated_subgrid(vtkUnstructuredGrid* sums) {
+  vtkDataArray* a = sums->GetCellData()->GetArray("subgrid_axial_velocity");
+  return a ? a->GetTuple1(0) : 0.0;
+}
+
+// The flux of u + u' through a polygonal dataset, mm²·m/s (0 when it is empty).
+double integrate_flux(vtkPolyData* data) {
   if (data->GetNumberOfCells() == 0) return 0.0;
   vtkNew<vtkIntegrateAttributes> integral;
   integral->SetInputData(data);
   integral->Update();
-  vtkDataArray* a = integral->GetOutput()->GetPointData()->GetArray(name);
-  return a ? a->GetTuple1(0) : 0.0;
+  return integrated_axial(integral->GetOutput()) + integrated_subgrid(integral->GetOutput());
 }
 
 std::vector<Loop> outline_loops(vtkPolyData* piece) {
@@ -106,6 +116,14 @@ double voxel_size(const HybridMesh& mesh) {
   return edges[edges.size() / 2];
 }
 
+std::vector<Eigen::Vector3d> subgrid_velocity(const airflow::SolvedMesh& solved) {
+  const airflow::SolutionState& st = solved.state;
+  std::vector<Eigen::Vector3d> sub =
+      ns::subgrid_velocity(solved.mesh, st.field, 1.0 / st.reynolds, st.d_in_mm);
+  for (Eigen::Vector3d& u : sub) u *= st.u_in;
+  return sub;
+}
+
 void add_flow_arrays(vtkPolyData* surface, const Eigen::Vector3d& normal) {
   vtkDataArray* velocity = surface->GetPointData()->GetArray("velocity");
   if (!velocity) fail("the section has no velocity");
@@ -129,6 +147,16 @@ void add_flow_arrays(vtkPolyData* surface, const Eigen::Vector3d& normal) {
   surface->GetPointData()->AddArray(secondary);
   surface->GetPointData()->AddArray(position);
   surface->GetPointData()->SetActiveScalars("speed");
+  vtkDataArray* subgrid = surface->GetCellData()->GetArray("subgrid_velocity");
+  if (!subgrid) return;
+  const vtkIdType cells = surface->GetNumberOfCells();
+  auto subgrid_axial = scalar_array("subgrid_axial_velocity", cells);
+  for (vtkIdType c = 0; c < cells; ++c) {
+    double u[3];
+    subgrid->GetTuple(c, u);
+    subgrid_axial->SetValue(c, Eigen::Vector3d(u[0], u[1], u[2]).dot(normal));
+  }
+  surface->GetCellData()->AddArray(subgrid_axial);
 }
 
 Measures measure_piece(vtkPolyData* piece, double smoothing, const std::vector<RegionBox>& regions,
@@ -141,9 +169,10 @@ Measures measure_piece(vtkPolyData* piece, double smoothing, const std::vector<R
   if (auto* a = sums->GetCellData()->GetArray("Area")) m.area = a->GetTuple1(0);
   m.region_flux.assign(regions.size(), 0.0);
   if (!(m.area > 0.0)) return m;
-  const double axial_sum = sums->GetPointData()->GetArray("axial_velocity")->GetTuple1(0);
-  m.flux = axial_sum * kMm2;
-  m.mean_axial = axial_sum / m.area;
+  const double axial_sum = integrated_axial(sums);
+  m.resolved_flux = axial_sum * kMm2;
+  m.flux = (axial_sum + integrated_subgrid(sums)) * kMm2;
+  m.mean_axial = m.flux / (m.area * kMm2);
   vtkDataArray* x = sums->GetPointData()->GetArray("position");  // ∫x dA
   m.centroid =
       Eigen::Vector3d(x->GetComponent(0, 0), x->GetComponent(0, 1), x->GetComponent(0, 2)) / m.area;
@@ -170,19 +199,21 @@ Measures measure_piece(vtkPolyData* piece, double smoothing, const std::vector<R
     clip->InsideOutOn();
     clip->Update();
     m.region_flux[static_cast<std::size_t>(&r - regions.data())] =
-        integrate(clip->GetOutput(), "axial_velocity") * kMm2;
+        integrate_flux(clip->GetOutput()) * kMm2;
   }
   return m;
 }
 
 SectionCutter::SectionCutter(const HybridMesh& mesh, std::span<const Eigen::Vector3d> velocity,
-                             double smoothing)
+                             std::span<const Eigen::Vector3d> subgrid, double smoothing)
     : mesh_(mesh),
       velocity_(velocity),
       smoothing_(smoothing),
       grid_(vtkSmartPointer<vtkUnstructuredGrid>::New()) {
   if (velocity.size() != mesh.nodes.size())
     fail("the velocity has {} nodes, the mesh {}", velocity.size(), mesh.nodes.size());
+  if (!subgrid.empty() && subgrid.size() != mesh.cell_count())
+    fail("the fine-scale velocity has {} cells, the mesh {}", subgrid.size(), mesh.cell_count());
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.nodes.size()));
@@ -207,6 +238,11 @@ SectionCutter::SectionCutter(const HybridMesh& mesh, std::span<const Eigen::Vect
   insert(VTK_TETRA, mesh.tets);
   insert(VTK_PYRAMID, mesh.pyramids);
   insert(VTK_HEXAHEDRON, mesh.hexes);
+  if (subgrid.empty()) return;
+  auto cell_velocity = vector_array("subgrid_velocity", static_cast<vtkIdType>(subgrid.size()));
+  for (std::size_t c = 0; c < subgrid.size(); ++c)
+    cell_velocity->SetTuple(static_cast<vtkIdType>(c), subgrid[c].data());
+  grid_->GetCellData()->AddArray(cell_velocity);
 }
 
 Section SectionCutter::cut(const SectionPlane& plane, const std::vector<RegionBox>& regions) const {
@@ -285,6 +321,7 @@ Section SectionCutter::cut(const SectionPlane& plane, const std::vector<RegionBo
   for (const Measures& m : s.pieces) {
     w.area += m.area, w.perimeter += m.perimeter, w.raw_perimeter += m.raw_perimeter;
     w.flux += m.flux;
+    w.resolved_flux += m.resolved_flux;
     w.centroid += m.area * m.centroid;
     w.max_axial = std::max(w.max_axial, m.max_axial);
     w.max_speed = std::max(w.max_speed, m.max_speed);

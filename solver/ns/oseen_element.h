@@ -75,6 +75,27 @@ inline double momentum_tau(const Eigen::Vector3d& a, const Eigen::Matrix3d& metr
   return std::sqrt(3.0 / (a.dot(metric * a) + nu * nu * metric.squaredNorm()));
 }
 
+// The element metric G = J^{-T} J^{-1}, on references of side 2 (the tet's, of side 1, is
+// scaled to match): it measures the cell along every direction, so a flat cell gets the small τ
+// of its thin direction.
+template <class E, class Mapped>
+Eigen::Matrix3d element_metric(const Mapped& m) {
+  return m.inverse_jacobian.transpose() * reference_metric<E>() * m.inverse_jacobian;
+}
+
+// f + ν ∇·(Σ N_j G_j): the force with the viscous term reconstructed from the recovered nodal
+// gradient (see the top of this file); `shape_gradient` the cell's ∂N_i/∂x at the point.
+template <int N>
+Eigen::Vector3d reconstructed_force(const Eigen::Vector3d& f,
+                                    const Eigen::Matrix<double, N, 3>& shape_gradient,
+                                    const Eigen::Matrix<double, N, 9>* grad, double nu) {
+  Eigen::Vector3d f_stab = f;
+  if (grad)
+    for (int c = 0; c < 3; ++c)
+      for (int d = 0; d < 3; ++d) f_stab[c] += nu * shape_gradient.col(d).dot(grad->col(3 * c + d));
+  return f_stab;
+}
+
 // The quadrature degree for each cell type: 2 is exact for the affine tet's terms; the pyramid
 // and the hexahedron use 2×2×2-type rules (3 points across the pyramid's collapsed axis).
 inline constexpr int kOseenQuadratureDegree = 2;
@@ -123,15 +144,8 @@ void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
     const Eigen::Matrix<double, N, 3>& G = m.gradient;
     const Eigen::Vector3d aq = a.transpose() * Nv;
     const Eigen::Vector3d f = force(Eigen::Vector3d(X.transpose() * Nv));
-    Eigen::Vector3d f_stab = f;
-    if (grad)
-      for (int c = 0; c < 3; ++c)
-        for (int d = 0; d < 3; ++d) f_stab[c] += nu * G.col(d).dot(grad->col(3 * c + d));
-    // The element metric G = J^{-T} J^{-1}, on references of side 2 (the tet's, of side 1, is
-    // scaled to match): it measures the cell along every direction, so a flat cell gets the
-    // small τ of its thin direction.
-    const Eigen::Matrix3d metric =
-        m.inverse_jacobian.transpose() * reference_metric<E>() * m.inverse_jacobian;
+    const Eigen::Vector3d f_stab = reconstructed_force<N>(f, G, grad, nu);
+    const Eigen::Matrix3d metric = element_metric<E>(m);
     const double tau_m = momentum_tau(aq, metric, nu);
     const double tau_c = 3.0 / (tau_m * metric.trace());
     const Eigen::Matrix<double, N, 1> adv = G * aq;  // (a·∇)N_i

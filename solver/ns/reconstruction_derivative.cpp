@@ -85,9 +85,7 @@ void ReconstructionDerivative::assemble_cells(const Cells& cells,
       const double w = table.points[q].weight * m.det_jacobian;
       const Eigen::Matrix<double, N, 3>& G = m.gradient;
       const Eigen::Vector3d aq = A.transpose() * m.value;
-      const Eigen::Matrix3d metric =
-          m.inverse_jacobian.transpose() * reference_metric<E>() * m.inverse_jacobian;
-      const double scale = w * nu * momentum_tau(aq, metric, nu);
+      const double scale = w * nu * momentum_tau(aq, element_metric<E>(m), nu);
       const Eigen::Matrix<double, N, 1> adv = G * aq;
       for (int i = 0; i < N; ++i)
         for (int j = 0; j < N; ++j) {

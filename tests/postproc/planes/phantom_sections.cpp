@@ -4,9 +4,9 @@
 //
 // prints, per plane of planes.csv (coronal, by distance behind the naris), the area and
 // perimeter naris measured beside the phantom's analytic ones (marching squares on its section
-// field) and the flux through the plane against the inlet's, and fails when an area misses by
-// more than AREA, a smoothed perimeter by more than PERIMETER or a flux by more than FLUX
-// (fractions).
+// field) and the flux through the plane against the inlet's (of u + u', and of the nodal u
+// alone), and fails when an area misses by more than AREA, a smoothed perimeter by more than
+// PERIMETER or the flux of u + u' by more than FLUX (fractions).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
   for (std::size_t i = 0; i < header.size(); ++i) column[header[i]] = i;
   std::printf(
       "| plane (mm) | area (mm²) | phantom | difference | perimeter smoothed (mm) | raw | phantom "
-      "| difference | flux / inlet |\n|---|---|---|---|---|---|---|---|---|\n");
+      "| difference | flux / inlet | nodal u alone |\n|---|---|---|---|---|---|---|---|---|---|\n");
   int failures = 0, rows = 0;
   while (std::getline(in, line)) {
     const auto f = split(line);
@@ -54,11 +54,12 @@ int main(int argc, char** argv) {
     const double area = std::stod(f[column["area_mm2"]]),
                  perimeter = std::stod(f[column["perimeter_mm"]]),
                  raw = std::stod(f[column["raw_perimeter_mm"]]),
-                 flux = std::stod(f[column["flux_to_inlet"]]);
+                 flux = std::stod(f[column["flux_to_inlet"]]),
+                 nodal = std::stod(f[column["resolved_flux_to_inlet"]]);
     const auto exact = phantom.section_area_perimeter(s);
     const double da = area / exact[0] - 1.0, dp = perimeter / exact[1] - 1.0;
-    std::printf("| %g | %.1f | %.1f | %+.1f %% | %.1f | %.1f | %.1f | %+.1f %% | %.4f |\n", s, area,
-                exact[0], 100 * da, perimeter, raw, exact[1], 100 * dp, flux);
+    std::printf("| %g | %.1f | %.1f | %+.1f %% | %.1f | %.1f | %.1f | %+.1f %% | %.4f | %.4f |\n",
+                s, area, exact[0], 100 * da, perimeter, raw, exact[1], 100 * dp, flux, nodal);
     failures += std::abs(da) > area_tolerance || std::abs(dp) > perimeter_tolerance ||
                 std::abs(flux - 1.0) > flux_tolerance;
     ++rows;
