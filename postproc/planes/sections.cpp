@@ -265,6 +265,9 @@ Section SectionCutter::cut(const SectionPlane& plane, const std::vector<RegionBo
   clean->Update();
   vtkSmartPointer<vtkPolyData> surface = clean->GetOutput();
   if (surface->GetNumberOfCells() == 0) fail("plane {} does not cut the airway", plane.label);
+  if (grid_->GetCellData()->GetArray("subgrid_velocity") &&
+      !surface->GetCellData()->GetArray("subgrid_velocity"))
+    fail("VTK's cutter dropped the fine-scale velocity of plane {}", plane.label);
   add_flow_arrays(surface, plane.normal);
 
   vtkNew<vtkPolyDataConnectivityFilter> all;

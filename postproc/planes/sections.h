@@ -28,7 +28,8 @@ struct Measures {
   double raw_hydraulic_diameter = 0.0;                 // mm: 4A/P on the raw perimeter
   double flux = 0.0;                                   // m³/s along the normal: u + u'
   double resolved_flux = 0.0;                          // m³/s: the nodal velocity u alone
-  double mean_axial = 0.0, max_axial = 0.0;            // m/s: flux/area; of u
+  double mean_axial = 0.0;                             // m/s: flux / area (u + u')
+  double max_axial = 0.0;                              // m/s: of u at the section's points
   double max_speed = 0.0;                              // m/s
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // mm
   std::vector<double> region_flux;  // m³/s (u + u') through each region box's part

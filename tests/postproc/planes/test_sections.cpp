@@ -39,24 +39,29 @@ std::vector<Vec3> uniform(const HybridMesh& m, const Vec3& u) {
   return std::vector<Vec3>(m.nodes.size(), u);
 }
 
+// With and without a fine-scale velocity per cell (VTK's cutter may take another path when the
+// grid has cell data): the flux of a uniform u + u' is (u + u')·n times the area.
 TEST(Sections, PlanarFacesGiveTheExactArea) {
-  for (const HybridMesh& m : {testing::box_hex(6), testing::box_tet(5)}) {
-    const std::vector<Vec3> u = uniform(m, Vec3(0.2, -0.1, 1.5));
-    const SectionCutter cutter(m, u, {}, voxel_size(m));
-    // Through cells, along a node layer, and oblique: a regular hexagon of side √2.
-    for (const auto& [p, area] : {std::pair{plane({0, 0, 0.3141}, {0, 0, 1}), 4.0},
-                                  std::pair{plane({0, 0, 1.0 / 3.0}, {0, 0, 1}), 4.0},
-                                  std::pair{plane({0, 0, 0}, {1, 1, 1}), 3.0 * std::sqrt(3.0)}}) {
-      const Section s = cutter.cut(p);
-      ASSERT_EQ(s.pieces.size(), 1u);
-      EXPECT_NEAR(s.whole.area / area - 1.0, 0.0, 1e-12) << p.normal.transpose();
-      // A uniform velocity: the flux is u·n times the area, the mean axial velocity u·n.
-      const double un = Vec3(0.2, -0.1, 1.5).dot(p.normal);
-      EXPECT_NEAR(s.whole.flux / (un * area * 1e-6) - 1.0, 0.0, 1e-12);
-      EXPECT_NEAR(s.whole.mean_axial / un - 1.0, 0.0, 1e-12);
-      EXPECT_NEAR(s.whole.max_speed, Vec3(0.2, -0.1, 1.5).norm(), 1e-12);
+  for (const HybridMesh& m : {testing::box_hex(6), testing::box_tet(5)})
+    for (const Vec3& fine : {Vec3(0, 0, 0), Vec3(0.05, 0.02, -0.3)}) {
+      const std::vector<Vec3> u = uniform(m, Vec3(0.2, -0.1, 1.5));
+      const std::vector<Vec3> sub =
+          fine.isZero() ? std::vector<Vec3>{} : std::vector<Vec3>(m.cell_count(), fine);
+      const SectionCutter cutter(m, u, sub, voxel_size(m));
+      // Through cells, along a node layer, and oblique: a regular hexagon of side √2.
+      for (const auto& [p, area] : {std::pair{plane({0, 0, 0.3141}, {0, 0, 1}), 4.0},
+                                    std::pair{plane({0, 0, 1.0 / 3.0}, {0, 0, 1}), 4.0},
+                                    std::pair{plane({0, 0, 0}, {1, 1, 1}), 3.0 * std::sqrt(3.0)}}) {
+        const Section s = cutter.cut(p);
+        ASSERT_EQ(s.pieces.size(), 1u);
+        EXPECT_NEAR(s.whole.area / area - 1.0, 0.0, 1e-12) << p.normal.transpose();
+        // A uniform velocity: the flux is u·n times the area, the mean axial velocity u·n.
+        const double un = (Vec3(0.2, -0.1, 1.5) + fine).dot(p.normal);
+        EXPECT_NEAR(s.whole.flux / (un * area * 1e-6) - 1.0, 0.0, 1e-12);
+        EXPECT_NEAR(s.whole.mean_axial / un - 1.0, 0.0, 1e-12);
+        EXPECT_NEAR(s.whole.max_speed, Vec3(0.2, -0.1, 1.5).norm(), 1e-12);
+      }
     }
-  }
 }
 
 TEST(Sections, APlaneOutsideTheMeshIsAnError) {
@@ -253,9 +258,11 @@ double volume_integral_z(const HybridMesh& m, const std::vector<Vec3>& nodal,
 
 // An abrupt contraction (radius 1 → 0.6 mm at z = 4 mm, on a node layer; 0.1 mm voxels) at
 // Re 100 on the inlet's diameter. Tested with q = z, the discrete continuity equation says
-// ∫_Ω (u + u')_z dΩ = L·Q. A plane's flux of u + u' is the inlet's within 0.5 % two voxels or
-// more from the step; within a voxel of it (where the cells' mean u' is a coarse stand-in for
-// u' on the plane) within 2.5 %, and nearer than the nodal velocity's alone, which loses 4–11 %.
+// ∫_Ω (u + u')_z dΩ = L·Q: to 1e-6, well above the solver's 1e-8 on the residual and far below
+// the fine scale's share (> 1e-3). A plane's flux of u + u' is the inlet's within 0.5 % (the
+// Poiseuille test's bound) two voxels or more from the step; within a voxel of it (where the
+// cells' mean u' is a coarse stand-in for u' on the plane) within 2.5 %, and nearer than the
+// nodal velocity's alone, which loses 4–11 % there.
 TEST(Sections, AContractionConservesTheFluxOfTheNodalPlusFineScaleVelocity) {
   petsc::Session session;
   const double length = 8.0;
@@ -291,7 +298,7 @@ TEST(Sections, AContractionConservesTheFluxOfTheNodalPlusFineScaleVelocity) {
     const Section s = cutter.cut(plane({0, 0, z}, {0, 0, 1}));
     const double total = s.whole.flux / inlet.flux, nodal = s.whole.resolved_flux / inlet.flux;
     std::printf("z %.2f: flux of u + u' %.4f, of u %.4f of the inlet's\n", z, total, nodal);
-    if (std::abs(z - 4.0) >= 0.2) {
+    if (std::abs(z - 4.0) > 0.15) {  // two voxels or more from the step
       EXPECT_NEAR(total, 1.0, 0.005) << "z = " << z;
     } else {
       EXPECT_NEAR(total, 1.0, 0.025) << "z = " << z;
