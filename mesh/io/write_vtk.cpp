@@ -50,9 +50,9 @@ vtkSmartPointer<vtkCellArray> make_cell_array(std::vector<vtkIdType>& offsets,
 
 void check_field_sizes(const HybridMesh& mesh, const CellFields& cell_fields,
                        const PointFields& point_fields) {
-  for (const auto& [name, values] : cell_fields)
-    if (values.size() != mesh.cell_count())
-      fail("internal: cell field '{}' has {} values for {} cells", name, values.size(),
+  for (const auto& [name, field] : cell_fields)
+    if (field.values.size() != static_cast<std::size_t>(field.components) * mesh.cell_count())
+      fail("internal: cell field '{}' has {} values for {} cells", name, field.values.size(),
            mesh.cell_count());
   for (const auto& [name, field] : point_fields)
     if (field.values.size() != static_cast<std::size_t>(field.components) * mesh.nodes.size())
@@ -82,7 +82,6 @@ void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
       sizeof(NodeId) * (4 * mesh.tets.size() + 5 * mesh.pyramids.size() + 8 * mesh.hexes.size());
   const std::uint64_t offsets_bytes = sizeof(std::int64_t) * cells;
   const std::uint64_t types_bytes = cells;
-  const std::uint64_t field_bytes = sizeof(float) * cells;
 
   std::string xml = fmt::format(
       "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
@@ -106,7 +105,8 @@ void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
   xml += "   </Cells>\n";
   if (!cell_fields.empty()) {
     xml += "   <CellData>\n";
-    for (const auto& [name, values] : cell_fields) array("Float32", name, 1, field_bytes);
+    for (const auto& [name, field] : cell_fields)
+      array("Float32", name, field.components, sizeof(float) * field.values.size());
     xml += "   </CellData>\n";
   }
   if (!point_fields.empty()) {
@@ -161,23 +161,16 @@ void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
     }
   }
   std::vector<float> block;
-  for (const auto& [name, values] : cell_fields) {
-    header(field_bytes);
-    for (std::size_t c = 0; c < cells; c += kBlock) {
-      block.assign(values.begin() + static_cast<std::ptrdiff_t>(c),
-                   values.begin() + static_cast<std::ptrdiff_t>(std::min(cells, c + kBlock)));
-      put(block.data(), block.size() * sizeof(float));
+  for (const auto* fields : {&cell_fields, &point_fields})
+    for (const auto& [name, field] : *fields) {
+      header(sizeof(float) * field.values.size());
+      for (std::size_t c = 0; c < field.values.size(); c += kBlock) {
+        block.assign(field.values.begin() + static_cast<std::ptrdiff_t>(c),
+                     field.values.begin() +
+                         static_cast<std::ptrdiff_t>(std::min(field.values.size(), c + kBlock)));
+        put(block.data(), block.size() * sizeof(float));
+      }
     }
-  }
-  for (const auto& [name, field] : point_fields) {
-    header(sizeof(float) * field.values.size());
-    for (std::size_t c = 0; c < field.values.size(); c += kBlock) {
-      block.assign(field.values.begin() + static_cast<std::ptrdiff_t>(c),
-                   field.values.begin() +
-                       static_cast<std::ptrdiff_t>(std::min(field.values.size(), c + kBlock)));
-      put(block.data(), block.size() * sizeof(float));
-    }
-  }
   const std::string tail = "\n </AppendedData>\n</VTKFile>\n";
   put(tail.data(), tail.size());
   if (std::fflush(file.get()) != 0) fail("{}: write failed (disk full?)", path.string());
@@ -227,21 +220,21 @@ void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path,
   renumber(part.pyramids);
   renumber(part.hexes);
 
-  CellFields part_cells;
-  for (const auto& [name, values] : cell_fields) {
-    auto& v = part_cells[name];
-    v.reserve(cells.size());
-    for (std::size_t k : cells) v.push_back(values[k]);
-  }
-  PointFields part_points;
-  for (const auto& [name, field] : point_fields) {
-    const auto m = static_cast<std::size_t>(field.components);
-    auto& f = part_points[name];
-    f.components = field.components;
-    f.values.reserve(m * global.size());
-    for (std::size_t n : global)
-      for (std::size_t k = 0; k < m; ++k) f.values.push_back(field.values[m * n + k]);
-  }
+  // The fields' values at the given cells or nodes of the whole mesh.
+  auto values_at = [](const PointFields& fields, const std::vector<std::size_t>& at) {
+    PointFields part_fields;
+    for (const auto& [name, field] : fields) {
+      const auto m = static_cast<std::size_t>(field.components);
+      auto& f = part_fields[name];
+      f.components = field.components;
+      f.values.reserve(m * at.size());
+      for (std::size_t n : at)
+        for (std::size_t k = 0; k < m; ++k) f.values.push_back(field.values[m * n + k]);
+    }
+    return part_fields;
+  };
+  const CellFields part_cells = values_at(cell_fields, cells);
+  const PointFields part_points = values_at(point_fields, global);
   write_vtu(part, pvtu_piece_path(path, piece), part_cells, part_points);
   if (piece != 0) return;
 
@@ -250,19 +243,15 @@ void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path,
       "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n <PUnstructuredGrid "
       "GhostLevel=\"0\">\n  <PPoints>\n   <PDataArray type=\"Float64\" "
       "NumberOfComponents=\"3\"/>\n  </PPoints>\n";
-  if (!cell_fields.empty()) {
-    xml += "  <PCellData>\n";
-    for (const auto& [name, values] : cell_fields)
-      xml += fmt::format("   <PDataArray type=\"Float32\" Name=\"{}\"/>\n", name);
-    xml += "  </PCellData>\n";
-  }
-  if (!point_fields.empty()) {
-    xml += "  <PPointData>\n";
-    for (const auto& [name, field] : point_fields)
+  for (const auto& [fields, tag] :
+       {std::pair{&cell_fields, "PCellData"}, std::pair{&point_fields, "PPointData"}}) {
+    if (fields->empty()) continue;
+    xml += fmt::format("  <{}>\n", tag);
+    for (const auto& [name, field] : *fields)
       xml +=
           fmt::format("   <PDataArray type=\"Float32\" Name=\"{}\" NumberOfComponents=\"{}\"/>\n",
                       name, field.components);
-    xml += "  </PPointData>\n";
+    xml += fmt::format("  </{}>\n", tag);
   }
   for (int k = 0; k < pieces; ++k)
     xml += fmt::format("  <Piece Source=\"{}\"/>\n", pvtu_piece_path(path, k).filename().string());

@@ -14,14 +14,14 @@ class vtkPolyData;
 
 namespace naris {
 
-// Cell arrays are given in the writer's cell order: tets, then pyramids, then hexes.
-using CellFields = std::map<std::string, std::vector<double>>;
-// Point arrays: `components` values per node, node after node.
-struct PointField {
+// `components` values per node or per cell, one after the other.
+struct FieldArray {
   int components = 1;
   std::vector<double> values;
 };
-using PointFields = std::map<std::string, PointField>;
+// Cell arrays are given in the writer's cell order: tets, then pyramids, then hexes.
+using CellFields = std::map<std::string, FieldArray>;
+using PointFields = std::map<std::string, FieldArray>;
 
 void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
                const CellFields& cell_fields = {}, const PointFields& point_fields = {});

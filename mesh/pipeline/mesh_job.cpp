@@ -254,7 +254,7 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
   if (job.write_vtu) {
     CellFields fields;
     for (Metric m : kMetrics) {
-      auto& v = fields[metric_name(m)];
+      auto& v = fields[metric_name(m)].values;
       v.reserve(r.quality.size());
       for (const auto& c : r.quality) v.push_back(c.get(m));
     }

@@ -12,6 +12,7 @@
 #include "core/units.h"
 #include "mesh/io/write_vtk.h"
 #include "solver/ns/reaction_force.h"
+#include "solver/ns/subgrid_velocity.h"
 #include "solver/ns/wall_stress.h"
 
 namespace naris::airflow {
@@ -165,14 +166,14 @@ void write_volume(const AirflowJob& job, const Partition& part, const ns::FlowFi
   const double u = r.u_in, pscale = job.density * u * u;
   PointFields fields;
   auto vector_field = [&](double scale) {
-    PointField f{3, {}};
+    FieldArray f{3, {}};
     f.values.reserve(3 * field.velocity.size());
     for (const auto& v : field.velocity)
       for (int c = 0; c < 3; ++c) f.values.push_back(v[c] * scale);
     return f;
   };
   auto scalar_field = [&](double scale) {
-    PointField f{1, {}};
+    FieldArray f{1, {}};
     for (double p : field.pressure) f.values.push_back(p * scale);
     return f;
   };
@@ -180,13 +181,22 @@ void write_volume(const AirflowJob& job, const Partition& part, const ns::FlowFi
   fields["pressure"] = scalar_field(pscale);
   fields["velocity_nondimensional"] = vector_field(1.0);
   fields["pressure_nondimensional"] = scalar_field(1.0);
+  // Each cell's mean fine-scale velocity (ns/subgrid_velocity.h): large against the velocity
+  // where the mesh does not resolve the flow.
+  CellFields cells;
+  FieldArray& fine = cells["subgrid_velocity"];
+  fine.components = 3;
+  fine.values.reserve(3 * part.piece.mesh.cell_count());
+  for (const Eigen::Vector3d& v :
+       ns::subgrid_velocity(part.piece.mesh, field, 1.0 / r.reynolds, r.d_in_mm))
+    for (int c = 0; c < 3; ++c) fine.values.push_back(v[c] * u);
   int rank = 0, ranks = 1;
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
   MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
   const fs::path vtu = job.output / "solution.vtu", pvtu = job.output / "solution.pvtu";
   if (rank == 0) remove_stale_volume_files(vtu, pvtu, ranks);
   if (ranks == 1) {
-    write_vtu(part.piece.mesh, vtu, {}, fields);
+    write_vtu(part.piece.mesh, vtu, cells, fields);
     written.push_back(vtu.string());
     return;
   }
@@ -196,7 +206,7 @@ void write_volume(const AirflowJob& job, const Partition& part, const ns::FlowFi
   try {
     write_pvtu_piece(
         part.piece.mesh, pvtu, rank, ranks,
-        [&](std::span<const NodeId> cell) { return part.piece.numbering.owns_cell(cell); }, {},
+        [&](std::span<const NodeId> cell) { return part.piece.numbering.owns_cell(cell); }, cells,
         fields);
   } catch (const Error& e) {
     failure = e.what();
@@ -212,7 +222,7 @@ void write_volume(const AirflowJob& job, const Partition& part, const ns::FlowFi
 void write_boundary(const AirflowJob& job, const Partition& part, const BoundaryShear& shear,
                     double pscale, std::vector<std::string>& written) {
   PointFields faces;
-  PointField vec{3, {}}, mag{1, {}}, cell{3, {}};
+  FieldArray vec{3, {}}, mag{1, {}}, cell{3, {}};
   for (const auto& s : shear.consistent) {
     for (int c = 0; c < 3; ++c) vec.values.push_back(s[c] * pscale);
     mag.values.push_back(s.norm() * pscale);

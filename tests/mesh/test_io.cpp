@@ -52,12 +52,32 @@ fs::path temp_dir() {
   return scratch.path;
 }
 
-// A cell field holding each cell's index, to see where a cell went.
+// A cell field holding each cell's index, to see where a cell went, and a vector one,
+// (i, 2i, −i) at cell i.
 CellFields cell_index_field(const HybridMesh& m) {
   CellFields fields;
-  auto& index = fields["index"];
-  for (std::size_t c = 0; c < m.cell_count(); ++c) index.push_back(static_cast<double>(c));
+  auto& index = fields["index"].values;
+  FieldArray& vector = fields["index_vector"];
+  vector.components = 3;
+  for (std::size_t c = 0; c < m.cell_count(); ++c) {
+    const auto i = static_cast<double>(c);
+    index.push_back(i);
+    vector.values.insert(vector.values.end(), {i, 2 * i, -i});
+  }
   return fields;
+}
+
+// The vector cell field agrees with the index field at every cell read back.
+void expect_index_vector(vtkUnstructuredGrid* grid) {
+  vtkDataArray* index = grid->GetCellData()->GetArray("index");
+  vtkDataArray* vector = grid->GetCellData()->GetArray("index_vector");
+  ASSERT_NE(vector, nullptr);
+  ASSERT_EQ(vector->GetNumberOfComponents(), 3);
+  for (vtkIdType c = 0; c < grid->GetNumberOfCells(); ++c) {
+    const double i = index->GetTuple1(c);
+    const double* v = vector->GetTuple3(c);
+    ASSERT_EQ(Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Vector3d(i, 2 * i, -i)) << c;
+  }
 }
 
 // A .vtu or .pvtu read back by VTK's own reader of that format.
@@ -117,6 +137,7 @@ TEST(Vtk, VtuAndStlReadBack) {
   vtkDataArray* read_index = grid->GetCellData()->GetArray("index");
   ASSERT_NE(read_index, nullptr);
   EXPECT_EQ(read_index->GetTuple1(first_hex), static_cast<double>(first_hex));
+  expect_index_vector(grid);
   write_stl(m, dir / "surface.stl");
   auto stl = vtkSmartPointer<vtkSTLReader>::New();
   stl->SetFileName((dir / "surface.stl").c_str());
@@ -160,6 +181,7 @@ TEST(Vtk, PvtuPiecesCoverTheMeshOnce) {
   for (vtkIdType c = 0; c < grid->GetNumberOfCells(); ++c)
     ++seen[static_cast<std::size_t>(read_index->GetTuple1(c))];
   EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(m.cell_count()));
+  expect_index_vector(grid);
   vtkDataArray* read_x = grid->GetPointData()->GetArray("x");
   ASSERT_NE(read_x, nullptr);
   ASSERT_EQ(read_x->GetNumberOfComponents(), 3);
