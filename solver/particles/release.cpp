@@ -35,7 +35,7 @@ int group_id(ReleaseSet& set, const std::string& name) {
 
 }  // namespace
 
-bool InletShape::contains(const Vec3& x) const {
+const std::array<Vec3, 3>* InletShape::triangle_under(const Vec3& x) const {
   for (const auto& t : triangles) {
     const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
     const double a2 = n.squaredNorm();
@@ -46,9 +46,34 @@ bool InletShape::contains(const Vec3& x) const {
       const Vec3& q = t[static_cast<std::size_t>((k + 1) % 3)];
       inside = (q - p).cross(x - p).dot(n) >= -1e-12 * a2;
     }
-    if (inside) return true;
+    if (inside) return &t;
   }
-  return false;
+  return nullptr;
+}
+
+bool InletShape::contains(const Vec3& x) const {
+  return triangle_under(x) != nullptr;
+}
+
+Vec3 InletShape::onto_patch(const Vec3& x) const {
+  const std::array<Vec3, 3>* t = triangle_under(x);
+  if (!t) return x;
+  const Vec3 n = ((*t)[1] - (*t)[0]).cross((*t)[2] - (*t)[0]);
+  const double along = normal.dot(n);
+  return std::abs(along) > 0.0 ? Vec3(x + ((*t)[0] - x).dot(n) / along * normal) : x;
+}
+
+int seed_inside(const InletShape& inlet, const FlowDomain& domain, Vec3& x) {
+  const Vec3 on = inlet.onto_patch(x);
+  double step = 1e-7;
+  for (int k = 0; k <= 5; ++k, step *= 4.0) {
+    const int cell = domain.locate(on - step * inlet.normal);
+    if (cell >= 0) {
+      x = on - step * inlet.normal;
+      return cell;
+    }
+  }
+  return -1;
 }
 
 double InletShape::distance_to_outline(const Vec3& x) const {
@@ -63,9 +88,14 @@ InletShape inlet_shape(const HybridMesh& mesh, int patch, const Vec3& up) {
   std::map<std::pair<NodeId, NodeId>, int> edges;  // undirected edge → uses
   for_each_boundary_face(mesh, [&](std::span<const NodeId> ids, std::int32_t p) {
     if (p != patch) return;
-    for (std::size_t k = 1; k + 1 < ids.size(); ++k)
-      s.triangles.push_back(
-          {mesh.nodes[ids[0]] * kMm, mesh.nodes[ids[k]] * kMm, mesh.nodes[ids[k + 1]] * kMm});
+    // A quadrilateral split as the tracker splits it (mesh_flow.h), along the diagonal through
+    // its lowest node, so that points placed on these triangles lie on the tracker's faces.
+    const std::size_t n = ids.size(),
+                      o = n == 4 ? static_cast<std::size_t>(
+                                       std::min_element(ids.begin(), ids.end()) - ids.begin())
+                                 : 0;
+    auto at = [&](std::size_t k) { return mesh.nodes[ids[(o + k) % n]] * kMm; };
+    for (std::size_t k = 1; k + 1 < n; ++k) s.triangles.push_back({at(0), at(k), at(k + 1)});
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const NodeId a = ids[k], b = ids[(k + 1) % ids.size()];
       ++edges[{std::min(a, b), std::max(a, b)}];

@@ -1,6 +1,7 @@
 #pragma once
 // Where particles start: sets of points on the inlet patch (the naris) or given by the user.
 // Positions are metres (the mesh's millimetres × 10⁻³), like the tracker's.
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -32,10 +33,20 @@ struct InletShape {
   std::vector<std::array<Vec3, 3>> triangles;  // the patch, fan-split
   std::vector<std::array<Vec3, 2>> outline;
   bool contains(const Vec3& x) const;  // x's projection lies on the patch
+  // The patch's triangle x projects onto (nullptr: none), and x moved along the normal onto
+  // it: a patch cut from a scan is planar only to a fraction of a voxel.
+  const std::array<Vec3, 3>* triangle_under(const Vec3& x) const;
+  Vec3 onto_patch(const Vec3& x) const;
   double distance_to_outline(const Vec3& x) const;
 };
 // Any planar patch (the outlet too); throws naris::Error when the patch has no faces.
 InletShape inlet_shape(const HybridMesh& mesh, int patch, const Vec3& up);
+
+// A seed x on the inlet moved onto its faces, then inside along the inward normal by the least
+// of 0.1 µm × 4^k (k = 0 … 5, so at most 0.1 mm) that `domain` locates: where a warped face is
+// split into two planes, the cells' half-spaces leave a sliver at the fold. Returns the cell
+// (x moved), or −1 when none of the steps is inside.
+int seed_inside(const InletShape& inlet, const FlowDomain& domain, Vec3& x);
 
 // Section 4.3.1's three groups on the long axis of the naris, each `count` points at least
 // `offset` (m) from its outline: "ventral-tip" (the lower sixth of the longest span of the axis

@@ -178,12 +178,11 @@ TraceResult run_trace_job(const TraceJob& job) {
   bool on_inlet = false;
   ReleaseSet release = make_release(job, mesh, inlet, naris, velocity, on_inlet);
   const MeshFlow flow(mesh, velocity, open);
-  // Seeds on the inlet move a tenth of a micrometre inside, off the boundary face.
-  const Vec3 inward = on_inlet ? Vec3(-naris->normal) : Vec3::Zero();
+  // Seeds on the inlet go onto its faces (the patch need not be planar), then just inside.
   std::vector<int> start_cell(release.points.size());
   for (std::size_t i = 0; i < release.points.size(); ++i) {
-    if (on_inlet) release.points[i] += 1e-7 * inward;
-    start_cell[i] = flow.locate(release.points[i]);
+    start_cell[i] =
+        on_inlet ? seed_inside(*naris, flow, release.points[i]) : flow.locate(release.points[i]);
     if (start_cell[i] < 0) {
       const Vec3 x = release.points[i] / kMm;
       fail("release point {} ({:.4g}, {:.4g}, {:.4g} mm) lies outside the airway", i + 1, x[0],
