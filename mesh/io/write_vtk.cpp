@@ -51,9 +51,10 @@ vtkSmartPointer<vtkCellArray> make_cell_array(std::vector<vtkIdType>& offsets,
 void check_field_sizes(const HybridMesh& mesh, const CellFields& cell_fields,
                        const PointFields& point_fields) {
   for (const auto& [name, field] : cell_fields)
-    if (field.values.size() != static_cast<std::size_t>(field.components) * mesh.cell_count())
-      fail("internal: cell field '{}' has {} values for {} cells", name, field.values.size(),
-           mesh.cell_count());
+    if (field.components < 1 ||
+        field.values.size() != static_cast<std::size_t>(field.components) * mesh.cell_count())
+      fail("internal: cell field '{}' has {} values of {} components for {} cells", name,
+           field.values.size(), field.components, mesh.cell_count());
   for (const auto& [name, field] : point_fields)
     if (field.values.size() != static_cast<std::size_t>(field.components) * mesh.nodes.size())
       fail("internal: point field '{}' has {} values for {} nodes", name, field.values.size(),

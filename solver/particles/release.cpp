@@ -33,18 +33,34 @@ int group_id(ReleaseSet& set, const std::string& name) {
   return static_cast<int>(set.groups.size()) - 1;
 }
 
+// A boundary face as triangles the way the tracker splits it (mesh_flow.h): a quadrilateral
+// along the diagonal through its lowest node, so points placed on them lie on its faces.
+template <class F>
+void tracker_triangles(std::span<const NodeId> ids, F&& triangle) {
+  const std::size_t n = ids.size(),
+                    o = n == 4 ? static_cast<std::size_t>(std::min_element(ids.begin(), ids.end()) -
+                                                          ids.begin())
+                               : 0;
+  for (std::size_t k = 1; k + 1 < n; ++k) triangle(ids[o], ids[(o + k) % n], ids[(o + k + 1) % n]);
+}
+
+// Triangles tilted more than this from the patch's plane (|n̂·normal| below it) are folds that
+// no point projects onto.
+constexpr double kFacing = 0.1;
+
 }  // namespace
 
 const std::array<Vec3, 3>* InletShape::triangle_under(const Vec3& x) const {
+  // Along the patch's normal: the triangles' projections on its plane tile the patch.
   for (const auto& t : triangles) {
     const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
-    const double a2 = n.squaredNorm();
-    if (a2 == 0.0) continue;
+    const double a = n.norm();
+    if (!(n.dot(normal) > kFacing * a)) continue;
     bool inside = true;
     for (int k = 0; k < 3 && inside; ++k) {
       const Vec3& p = t[static_cast<std::size_t>(k)];
       const Vec3& q = t[static_cast<std::size_t>((k + 1) % 3)];
-      inside = (q - p).cross(x - p).dot(n) >= -1e-12 * a2;
+      inside = (q - p).cross(x - p).dot(normal) >= -1e-12 * a;
     }
     if (inside) return &t;
   }
@@ -59,14 +75,13 @@ Vec3 InletShape::onto_patch(const Vec3& x) const {
   const std::array<Vec3, 3>* t = triangle_under(x);
   if (!t) return x;
   const Vec3 n = ((*t)[1] - (*t)[0]).cross((*t)[2] - (*t)[0]);
-  const double along = normal.dot(n);
-  return std::abs(along) > 0.0 ? Vec3(x + ((*t)[0] - x).dot(n) / along * normal) : x;
+  return x + ((*t)[0] - x).dot(n) / normal.dot(n) * normal;  // n·normal > kFacing |n|
 }
 
 int seed_inside(const InletShape& inlet, const FlowDomain& domain, Vec3& x) {
   const Vec3 on = inlet.onto_patch(x);
   double step = 1e-7;
-  for (int k = 0; k <= 5; ++k, step *= 4.0) {
+  for (int k = 0; k <= 5; ++k, step *= 4.0) {  // 0.1 µm … 0.1024 mm
     const int cell = domain.locate(on - step * inlet.normal);
     if (cell >= 0) {
       x = on - step * inlet.normal;
@@ -88,14 +103,9 @@ InletShape inlet_shape(const HybridMesh& mesh, int patch, const Vec3& up) {
   std::map<std::pair<NodeId, NodeId>, int> edges;  // undirected edge → uses
   for_each_boundary_face(mesh, [&](std::span<const NodeId> ids, std::int32_t p) {
     if (p != patch) return;
-    // A quadrilateral split as the tracker splits it (mesh_flow.h), along the diagonal through
-    // its lowest node, so that points placed on these triangles lie on the tracker's faces.
-    const std::size_t n = ids.size(),
-                      o = n == 4 ? static_cast<std::size_t>(
-                                       std::min_element(ids.begin(), ids.end()) - ids.begin())
-                                 : 0;
-    auto at = [&](std::size_t k) { return mesh.nodes[ids[(o + k) % n]] * kMm; };
-    for (std::size_t k = 1; k + 1 < n; ++k) s.triangles.push_back({at(0), at(k), at(k + 1)});
+    tracker_triangles(ids, [&](NodeId a, NodeId b, NodeId c) {
+      s.triangles.push_back({mesh.nodes[a] * kMm, mesh.nodes[b] * kMm, mesh.nodes[c] * kMm});
+    });
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const NodeId a = ids[k], b = ids[(k + 1) % ids.size()];
       ++edges[{std::min(a, b), std::max(a, b)}];
@@ -215,9 +225,9 @@ ReleaseSet line_release(const Vec3& a, const Vec3& b, int count) {
 ReleaseSet flux_weighted_release(const HybridMesh& mesh, int patch, std::span<const Vec3> velocity,
                                  int count, std::uint64_t seed) {
   if (count < 1) fail("flux-weighted release needs at least one particle (got {})", count);
-  // Fan triangles of the patch with their inflow at the corners: density ∝ −u·n, linear. A
-  // triangle is drawn by area × its largest corner inflow, then a uniform point in it is kept
-  // with probability inflow / largest: together ∝ the inflow.
+  // The patch's triangles (split as the tracker's) with their inflow at the corners: density ∝
+  // −u·n, linear. A triangle is drawn by area × its largest corner inflow, then a uniform point in
+  // it is kept with probability inflow / largest: together ∝ the inflow.
   struct Triangle {
     std::array<NodeId, 3> v;
     std::array<double, 3> inflow;
@@ -229,19 +239,19 @@ ReleaseSet flux_weighted_release(const HybridMesh& mesh, int patch, std::span<co
   for_each_boundary_face(mesh, [&](std::span<const NodeId> ids, std::int32_t p) {
     if (p != patch) return;
     const Vec3 n = polygon_vector_area(mesh, ids).normalized();
-    for (std::size_t k = 1; k + 1 < ids.size(); ++k) {
-      Triangle t{{ids[0], ids[k], ids[k + 1]}, {}, 0.0};
-      for (int c = 0; c < 3; ++c)
-        t.inflow[c] = std::max(0.0, -velocity[static_cast<std::size_t>(t.v[c])].dot(n));
+    tracker_triangles(ids, [&](NodeId a, NodeId b, NodeId c) {
+      Triangle t{{a, b, c}, {}, 0.0};
+      for (int k = 0; k < 3; ++k)
+        t.inflow[k] = std::max(0.0, -velocity[static_cast<std::size_t>(t.v[k])].dot(n));
       const double area = 0.5 * (mesh.nodes[t.v[1]] - mesh.nodes[t.v[0]])
                                     .cross(mesh.nodes[t.v[2]] - mesh.nodes[t.v[0]])
                                     .norm();
       t.weight = area * std::max({t.inflow[0], t.inflow[1], t.inflow[2]});
-      if (t.weight <= 0.0) continue;
+      if (t.weight <= 0.0) return;
       total += t.weight;
       tris.push_back(t);
       cumulative.push_back(total);
-    }
+    });
   });
   if (!(total > 0.0)) fail("no air flows in through the inlet: nothing to weight the release by");
   std::mt19937_64 rng(seed);

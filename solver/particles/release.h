@@ -30,11 +30,12 @@ struct InletShape {
   Vec3 centre = Vec3::Zero(), normal = Vec3::UnitZ();
   Vec3 long_axis = Vec3::UnitX(), short_axis = Vec3::UnitY();
   double area = 0.0;
-  std::vector<std::array<Vec3, 3>> triangles;  // the patch, fan-split
+  std::vector<std::array<Vec3, 3>> triangles;  // the patch, split as the tracker splits it
   std::vector<std::array<Vec3, 2>> outline;
-  bool contains(const Vec3& x) const;  // x's projection lies on the patch
-  // The patch's triangle x projects onto (nullptr: none), and x moved along the normal onto
-  // it: a patch cut from a scan is planar only to a fraction of a voxel.
+  bool contains(const Vec3& x) const;  // x's projection along the normal lies on the patch
+  // The patch's triangle x projects onto along the normal (nullptr: none; a triangle whose
+  // normal is more than 84° from the patch's is a fold and skipped), and x moved along the
+  // normal onto it: a patch cut from a scan is planar only to a fraction of a voxel.
   const std::array<Vec3, 3>* triangle_under(const Vec3& x) const;
   Vec3 onto_patch(const Vec3& x) const;
   double distance_to_outline(const Vec3& x) const;
@@ -43,7 +44,7 @@ struct InletShape {
 InletShape inlet_shape(const HybridMesh& mesh, int patch, const Vec3& up);
 
 // A seed x on the inlet moved onto its faces, then inside along the inward normal by the least
-// of 0.1 µm × 4^k (k = 0 … 5, so at most 0.1 mm) that `domain` locates: where a warped face is
+// of 0.1 µm × 4^k (k = 0 … 5, so at most 0.1024 mm) that `domain` locates: where a warped face is
 // split into two planes, the cells' half-spaces leave a sliver at the fold. Returns the cell
 // (x moved), or −1 when none of the steps is inside.
 int seed_inside(const InletShape& inlet, const FlowDomain& domain, Vec3& x);
