@@ -222,8 +222,8 @@ void write_pvtu_piece(const HybridMesh& mesh, const std::filesystem::path& path,
   renumber(part.hexes);
 
   // The fields' values at the given cells or nodes of the whole mesh.
-  auto values_at = [](const PointFields& fields, const std::vector<std::size_t>& at) {
-    PointFields part_fields;
+  auto values_at = [](const FieldArrays& fields, const std::vector<std::size_t>& at) {
+    FieldArrays part_fields;
     for (const auto& [name, field] : fields) {
       const auto m = static_cast<std::size_t>(field.components);
       auto& f = part_fields[name];

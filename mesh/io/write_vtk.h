@@ -19,9 +19,10 @@ struct FieldArray {
   int components = 1;
   std::vector<double> values;
 };
+using FieldArrays = std::map<std::string, FieldArray>;
 // Cell arrays are given in the writer's cell order: tets, then pyramids, then hexes.
-using CellFields = std::map<std::string, FieldArray>;
-using PointFields = std::map<std::string, FieldArray>;
+using CellFields = FieldArrays;
+using PointFields = FieldArrays;
 
 void write_vtu(const HybridMesh& mesh, const std::filesystem::path& path,
                const CellFields& cell_fields = {}, const PointFields& point_fields = {});

@@ -22,6 +22,7 @@
 
 #include "core/error.h"
 #include "core/units.h"
+#include "solver/airflow/solution_file.h"
 #include "solver/ns/subgrid_velocity.h"
 
 namespace naris::planes {

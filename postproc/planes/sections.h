@@ -17,7 +17,10 @@
 #include "mesh/hybrid_mesh.h"
 #include "mesh/patches/section_planes.h"
 #include "postproc/planes/outline.h"
-#include "solver/airflow/solution_file.h"
+
+namespace naris::airflow {
+struct SolvedMesh;
+}
 
 namespace naris::planes {
 

@@ -172,10 +172,12 @@ TEST(Outline, SmoothingKeepsACircleAndRemovesAStaircase) {
 }
 
 // An MVE pipe along z from 0 to `length` mm of radius `radius(z)` mm (0.1 mm voxels, inlet
-// diameter D = 2 mm), its flow solved by naris at `re` on D.
+// diameter D = 2 mm), its flow solved by naris at `re` on D, with U = 0.5 m/s for the SI fields.
 struct PipeFlow {
   HybridMesh mesh, unit;  // in mm, and in units of D (the solver's)
   ns::FlowField field;
+  std::vector<Vec3> subgrid;                  // per cell, nondimensional
+  std::vector<Vec3> velocity_si, subgrid_si;  // m/s
   bool converged = false;
 };
 PipeFlow pipe_flow(const std::function<double(double)>& radius, double length,
@@ -193,6 +195,9 @@ PipeFlow pipe_flow(const std::function<double(double)>& radius, double length,
   nonlinear::NonlinearReport report;
   r.field = nonlinear::solve_navier_stokes(r.unit, ns::FlowProblem{re, {}, bc}, {}, &report);
   r.converged = report.converged;
+  r.subgrid = ns::subgrid_velocity(r.unit, r.field, 1.0 / re, 1.0);
+  for (const Vec3& v : r.field.velocity) r.velocity_si.push_back(0.5 * v);
+  for (const Vec3& v : r.subgrid) r.subgrid_si.push_back(0.5 * v);
   return r;
 }
 
@@ -204,12 +209,7 @@ TEST(Sections, PoiseuilleFlowKeepsItsFluxAndPeak) {
       pipe_flow([](double) { return 1.0; }, 10.0, ns::InletProfile::developed, 10.0);
   ASSERT_TRUE(pipe.converged);
   const HybridMesh& m = pipe.mesh;
-  const ns::FlowField& f = pipe.field;
-  std::vector<Vec3> u(f.velocity.begin(), f.velocity.end());
-  for (Vec3& v : u) v *= 0.5;  // m/s
-  std::vector<Vec3> sub = ns::subgrid_velocity(m, f, 0.1, 2.0);
-  for (Vec3& v : sub) v *= 0.5;
-  const SectionCutter cutter(m, u, sub, voxel_size(m));
+  const SectionCutter cutter(m, pipe.velocity_si, pipe.subgrid_si, voxel_size(m));
   const Measures inlet = cutter.patch(m.patch_id("inlet"));
   ASSERT_GT(inlet.flux, 0.0);
   for (double z : {1.0, 2.55, 5.0, 7.43, 9.0}) {
@@ -271,7 +271,7 @@ TEST(Sections, AContractionConservesTheFluxOfTheNodalPlusFineScaleVelocity) {
   ASSERT_TRUE(pipe.converged);
   const HybridMesh &m = pipe.mesh, &unit = pipe.unit;
   const ns::FlowField& f = pipe.field;
-  const std::vector<Vec3> sub = ns::subgrid_velocity(unit, f, 0.01, 1.0);
+  const std::vector<Vec3>& sub = pipe.subgrid;
   ASSERT_EQ(sub.size(), m.cell_count());
   const std::vector<Vec3> sub_mm = ns::subgrid_velocity(m, f, 0.01, 2.0);
   double scale_difference = 0.0, largest = 0.0;
@@ -289,10 +289,7 @@ TEST(Sections, AContractionConservesTheFluxOfTheNodalPlusFineScaleVelocity) {
   EXPECT_NEAR((resolved + fine) / expected, 1.0, 1e-6);
   EXPECT_GT(std::abs(fine / expected), 1e-3);  // the fine scale carries a share
 
-  std::vector<Vec3> u(f.velocity.begin(), f.velocity.end()), sub_si = sub;
-  for (Vec3& v : u) v *= 0.5;  // m/s at U = 0.5 m/s
-  for (Vec3& v : sub_si) v *= 0.5;
-  const SectionCutter cutter(m, u, sub_si, voxel_size(m));
+  const SectionCutter cutter(m, pipe.velocity_si, pipe.subgrid_si, voxel_size(m));
   const Measures inlet = cutter.patch(m.patch_id("inlet"));
   for (double z : {1.0, 3.0, 3.8, 3.93, 3.97, 4.03, 4.07, 4.2, 4.5, 6.0, 7.5}) {
     const Section s = cutter.cut(plane({0, 0, z}, {0, 0, 1}));
