@@ -26,8 +26,10 @@ void add_solve_command(CLI::App& app) {
   auto [o, cmd] = add_stage<SolveSettings>(
       app, "solve",
       "Solve the steady incompressible airflow in a mesh made by naris mesh (patches inlet, "
-      "outlet, wall): uniform, developed or expression inlet velocity, traction-free outlet, "
-      "no-slip walls, Reynolds-number continuation to the target; writes solution.h5 (+ .xdmf), "
+      "outlet, wall): uniform, developed or expression inlet velocity and a traction-free "
+      "outlet, or (--drive outlet) the flow drawn out of the outlet with the inlet open to still "
+      "air; no-slip walls, Reynolds-number continuation to the target; writes solution.h5 (+ "
+      ".xdmf), "
       "solution.vtu (under MPI solution.pvtu with a piece per rank), boundary.vtp, summary.json, "
       "residuals.csv and checkpoint.h5 into -o");
   cmd->add_option("mesh", o->job.mesh, "mesh.h5 written by naris mesh")->required();

@@ -123,7 +123,16 @@ SolveSettings::SolveSettings() {
   table.add("re", job.reynolds, "target Reynolds number on the inlet's d_in = 4A/P").positive();
   table.add("inlet_speed", job.inlet_speed,
             "mean inlet speed (m/s) instead of re; Re then follows from it");
-  table.add("inlet_profile", inlet_profile, "uniform or developed (laminar, any shape)")
+  table
+      .add("drive", drive,
+           "inlet: the flow blown into the inlet, the outlet traction-free (the dissertation's "
+           "models); outlet: the same flow drawn out of the outlet, the inlet open to still air "
+           "at zero total pressure, so that its openings (both nares) share the flow as the flow "
+           "decides")
+      .one_of({"inlet", "outlet"});
+  table
+      .add("inlet_profile", inlet_profile,
+           "uniform or developed (laminar, any shape): the velocity's shape on the driven patch")
       .one_of({"uniform", "developed"});
   table.add("inlet_expression", job.inlet_expression,
             "inlet profile as an expression of x, y, z and r (mm; r from the inlet's centroid), "
@@ -220,6 +229,7 @@ airflow::AirflowJob SolveSettings::resolve(const std::filesystem::path& base) co
     j.nonlinear.max_iterations = 500;
   j.nonlinear.reuse_preconditioner = !rebuild_preconditioner;
   j.nonlinear.log_iterations = verbose;
+  j.drive = drive == "outlet" ? ns::DrivenPatch::outlet : ns::DrivenPatch::inlet;
   j.profile = table.given("inlet_expression") ? ns::InletProfile::expression
               : inlet_profile == "developed"  ? ns::InletProfile::developed
                                               : ns::InletProfile::uniform;

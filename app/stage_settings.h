@@ -51,7 +51,7 @@ struct MeshSettings : StageSettings<MeshJob> {
 };
 
 struct SolveSettings : StageSettings<airflow::AirflowJob> {
-  std::string inlet_profile = "uniform", scheme = "coupled", petsc;
+  std::string inlet_profile = "uniform", scheme = "coupled", drive = "inlet", petsc;
   std::optional<std::string> restart, restart_mesh;
   bool rebuild_preconditioner = !job.nonlinear.reuse_preconditioner;
   bool verbose = job.nonlinear.log_iterations;

@@ -253,4 +253,64 @@ std::vector<PatchReport> patch_report(const HybridMesh& mesh) {
   return report;
 }
 
+PatchOpenings patch_openings(const HybridMesh& mesh, int patch) {
+  // Union–find over the patch's nodes.
+  std::vector<NodeId> parent(mesh.nodes.size(), -1);
+  const auto root = [&](NodeId n) {
+    while (parent[static_cast<std::size_t>(n)] != n) {
+      NodeId& p = parent[static_cast<std::size_t>(n)];
+      p = parent[static_cast<std::size_t>(p)];
+      n = p;
+    }
+    return n;
+  };
+  for_each_boundary_face(mesh, [&](std::span<const NodeId> face, std::int32_t id) {
+    if (id != patch) return;
+    for (NodeId n : face)
+      if (parent[static_cast<std::size_t>(n)] < 0) parent[static_cast<std::size_t>(n)] = n;
+    for (std::size_t k = 1; k < face.size(); ++k) {
+      const NodeId a = root(face[0]), b = root(face[k]);
+      if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+    }
+  });
+  PatchOpenings o;
+  std::vector<int> index(mesh.nodes.size(), -1);  // per root
+  std::vector<Eigen::Vector3d> moment;
+  for_each_boundary_face(mesh, [&](std::span<const NodeId> face, std::int32_t id) {
+    if (id != patch) {
+      o.of_face.push_back(-1);
+      return;
+    }
+    int& k = index[static_cast<std::size_t>(root(face[0]))];
+    if (k < 0) {
+      k = static_cast<int>(o.area.size());
+      o.area.push_back(0.0);
+      moment.push_back(Eigen::Vector3d::Zero());
+    }
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (NodeId n : face) c += mesh.nodes[n];
+    const double a = polygon_area(mesh, face);
+    o.area[static_cast<std::size_t>(k)] += a;
+    moment[static_cast<std::size_t>(k)] += a * c / static_cast<double>(face.size());
+    o.of_face.push_back(k);
+  });
+  std::vector<int> order(o.area.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return o.area[static_cast<std::size_t>(a)] > o.area[static_cast<std::size_t>(b)];
+  });
+  std::vector<int> rank(order.size());
+  PatchOpenings sorted;
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    const auto k = static_cast<std::size_t>(order[r]);
+    rank[k] = static_cast<int>(r);
+    sorted.area.push_back(o.area[k]);
+    sorted.centroid.push_back(moment[k] / o.area[k]);
+  }
+  sorted.of_face = std::move(o.of_face);
+  for (int& k : sorted.of_face)
+    if (k >= 0) k = rank[static_cast<std::size_t>(k)];
+  return sorted;
+}
+
 }  // namespace naris

@@ -65,4 +65,14 @@ struct PatchReport {
 };
 std::vector<PatchReport> patch_report(const HybridMesh& mesh);
 
+// The connected pieces of one patch (faces that share a node), such as the two nares of an
+// inlet cut across both: per boundary face (in for_each_boundary_face's order) the index of its
+// opening, −1 off the patch; and each opening's area and centroid (mesh units), largest first.
+struct PatchOpenings {
+  std::vector<int> of_face;
+  std::vector<double> area;
+  std::vector<Eigen::Vector3d> centroid;
+};
+PatchOpenings patch_openings(const HybridMesh& mesh, int patch);
+
 }  // namespace naris

@@ -38,6 +38,10 @@ void check_job(const AirflowJob& job) {
   if (!(job.start_reynolds > 0.0)) fail("the starting Reynolds number must be positive");
   // A typo in the expression is an input error: caught here, before any output.
   if (job.profile == ns::InletProfile::expression) (void)ns::InletExpression(job.inlet_expression);
+  if (job.drive == ns::DrivenPatch::outlet && job.profile == ns::InletProfile::expression)
+    fail(
+        "an inlet expression shapes the inflow; driven at the outlet the inlet is open (give "
+        "uniform or developed, the outflow's shape)");
 }
 
 // The mesh as read and checked, and what the problem takes from it.
@@ -46,6 +50,7 @@ struct AirflowMesh {
   std::uint64_t fingerprint = 0;
   int inlet = -1, outlet = -1;
   ns::DirichletConditions conditions;  // on the whole mesh, in units of U_in
+  PatchOpenings openings;              // of the inlet, in mm
 };
 
 // Reads and checks the mesh; its inlet gives d_in and with it U_in and Re (into r).
@@ -71,13 +76,18 @@ AirflowMesh read_airflow_mesh(const AirflowJob& job, AirflowResult& r) {
   if (!check.valid())
     fail("{}: the mesh is not valid ({}); remesh it with naris mesh", job.mesh.string(),
          check.describe());
-  for (const auto& p : patch_report(mesh))
+  double outlet_area = 0.0;
+  for (const auto& p : patch_report(mesh)) {
     if (p.name == "inlet") {
       r.inlet_area_mm2 = p.area;
       r.inlet_perimeter_mm = p.perimeter;
       r.d_in_mm = p.hydraulic_diameter();
     }
+    if (p.name == "outlet") outlet_area = p.area;
+  }
   if (!(r.d_in_mm > 0.0)) fail("{}: the inlet patch has no area", job.mesh.string());
+  if (!(outlet_area > 0.0)) fail("{}: the outlet patch has no area", job.mesh.string());
+  m.openings = patch_openings(mesh, m.inlet);
   const double d_in = r.d_in_mm * kMm;
   r.u_in = job.inlet_speed ? *job.inlet_speed : job.reynolds * job.viscosity / d_in;
   r.reynolds = r.u_in * d_in / job.viscosity;
@@ -89,7 +99,10 @@ AirflowMesh read_airflow_mesh(const AirflowJob& job, AirflowResult& r) {
     expression.emplace(job.inlet_expression);
     shape = [&](const Eigen::Vector3d& x, double distance) { return (*expression)(x, distance); };
   }
-  m.conditions = ns::airflow_conditions(mesh, job.profile, 1.0, nullptr, shape);
+  // Driven at the outlet, the same flux leaves there: its mean speed is A_in / A_out.
+  const double mean_speed =
+      job.drive == ns::DrivenPatch::outlet ? r.inlet_area_mm2 / outlet_area : 1.0;
+  m.conditions = ns::airflow_conditions(mesh, job.profile, mean_speed, nullptr, shape, job.drive);
   return m;
 }
 
@@ -177,8 +190,12 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   ns::FlowProblem problem;
   problem.reynolds = r.reynolds;
   problem.conditions = ns::local_conditions(m.conditions, part.piece.numbering);
-  problem.backflow.patch = m.outlet;
-  problem.backflow.beta = 1.0;
+  // The natural patch's backflow term: on an outlet it stabilizes; on an inlet open to still
+  // air, β = ½ gives its static pressure −½ (u·n)², zero total pressure (flow_problem.h).
+  if (job.drive == ns::DrivenPatch::inlet)
+    problem.backflow.patches = {{m.outlet, 1.0}};
+  else
+    problem.backflow.patches = {{m.inlet, 0.5}};
   // What every solution file of the run carries besides its field and Re.
   SolutionState scales{.target_reynolds = r.reynolds,
                        .u_in = r.u_in,
@@ -187,7 +204,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
                        .viscosity = job.viscosity,
                        .mesh_fingerprint = m.fingerprint};
   PieceSolves solves(
-      part.piece.mesh, part.piece.numbering, std::move(problem), m.inlet, m.outlet, scales,
+      part.piece.mesh, part.piece.numbering, std::move(problem), m.inlet, m.outlet, job.drive,
+      scales,
       {job.output / "checkpoint.h5", job.output / "branch.csv", job.output / "residuals.csv"});
 
   continuation::ReynoldsContinuation continuation(continuation_settings(job, r.reynolds), solves);
@@ -205,7 +223,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   }
   continuation.run();
   r.steps = continuation.steps();
-  write_airflow_outputs(job, part, solves, continuation.solution(), r);
+  write_airflow_outputs(job, part, solves, continuation.solution(), m.openings, r);
   r.seconds = total.seconds();
   if (rank == 0) write_summary_json(job, r);
   return r;

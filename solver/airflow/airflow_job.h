@@ -31,6 +31,10 @@ struct AirflowJob {
   double density = 1.2;                       // kg/m³ (air)
   ns::InletProfile profile = ns::InletProfile::uniform;
   std::string inlet_expression;  // with InletProfile::expression (inlet_expression.h)
+  // Where the flow is imposed: blown into the inlet (the outlet traction-free), or drawn out of
+  // the outlet with the inlet open to still air at ambient total pressure, so that its openings
+  // (both nares) share the flow as the flow decides. Either way the flux is U_in × inlet area.
+  ns::DrivenPatch drive = ns::DrivenPatch::inlet;
   double start_reynolds = 50.0;  // the first continuation step
   int max_steps = 40;            // continuation steps, failed ones included
   double step_tolerance = 1e-5;  // of the steps before the target (reynolds_continuation.h)
@@ -49,7 +53,17 @@ struct AirflowResult {
   double d_in_mm = 0.0, inlet_area_mm2 = 0.0, inlet_perimeter_mm = 0.0;
   double u_in = 0.0, reynolds = 0.0;
   double flow_ml_s = 0.0, pressure_drop_pa = 0.0, resistance = 0.0, max_speed = 0.0;
-  double outlet_flow_ml_s = 0.0;  // mass balance check
+  double inlet_flow_ml_s = 0.0, outlet_flow_ml_s = 0.0;  // measured: the mass balance
+  // Driven at the outlet: the drop from the ambient air (total pressure 0) to the outlet's
+  // area-averaged pressure, what rhinomanometry measures; 0 otherwise.
+  double ambient_drop_pa = 0.0;
+  // The inlet patch's connected pieces (the nares), largest first, and the flow through each.
+  struct Opening {
+    double area_mm2 = 0.0;
+    Eigen::Vector3d centroid_mm = Eigen::Vector3d::Zero();
+    double flow_ml_s = 0.0;
+  };
+  std::vector<Opening> openings;
   struct Patch {
     std::string name;
     double area_mm2 = 0.0;

@@ -33,6 +33,10 @@ std::string profile_name(const AirflowJob& job) {
   return {};
 }
 
+const char* drive_name(const AirflowJob& job) {
+  return job.drive == ns::DrivenPatch::outlet ? "outlet" : "inlet";
+}
+
 // Before a run writes its volume as `vtu` (ranks == 1) or as `pvtu` with `ranks` pieces: the
 // files of the other form, and pieces beyond the new count, from an earlier run.
 void remove_stale_volume_files(const fs::path& vtu, const fs::path& pvtu, int ranks) {
@@ -119,18 +123,29 @@ void patch_shear(const HybridMesh& piece, const std::vector<Eigen::Vector3d>& sh
 
 // The flow's numbers in SI into r, and the wall shear stress.
 BoundaryShear flow_results(const AirflowJob& job, const Partition& part, const PieceSolves& solves,
-                           const ns::FlowField& field, AirflowResult& r) {
+                           const ns::FlowField& field, const PatchOpenings& openings,
+                           AirflowResult& r) {
   const double u = r.u_in, pscale = job.density * u * u;
-  r.flow_ml_s = u * r.inlet_area_mm2;  // m/s × mm² = 1e-6 m³/s = mL/s
-  r.outlet_flow_ml_s = solves.outlet_flux(field) * u * r.d_in_mm * r.d_in_mm;
+  const double flow_scale = u * r.d_in_mm * r.d_in_mm;  // m/s × mm² = 1e-6 m³/s = mL/s
+  r.flow_ml_s = u * r.inlet_area_mm2;
+  const HybridMesh& piece = part.piece.mesh;
+  r.inlet_flow_ml_s = -solves.flux_out(field, piece.patch_id("inlet")) * flow_scale;
+  r.outlet_flow_ml_s = solves.flux_out(field, piece.patch_id("outlet")) * flow_scale;
+  const std::vector<double> inflows =
+      solves.opening_inflows(field, openings.of_face, openings.area.size(), part.piece.face_index);
+  r.openings.clear();
+  for (std::size_t k = 0; k < inflows.size(); ++k)
+    r.openings.push_back({openings.area[k], openings.centroid[k], inflows[k] * flow_scale});
   r.pressure_drop_pa = solves.pressure_drop(field) * pscale;
+  if (job.drive == ns::DrivenPatch::outlet)
+    r.ambient_drop_pa = -solves.outlet_pressure(field) * pscale;
   r.resistance = r.pressure_drop_pa / r.flow_ml_s;
   r.max_speed = solves.max_speed(field) * u;
   // Stresses on the boundary, while the geometry is still nondimensional.
   ns::WallStress stress = ns::wall_stress(part.piece.mesh, field, r.reynolds);
   const ns::Reactions reactions = solves.reaction_forces(field, r.reynolds);
   const std::vector<Eigen::Vector3d>& forces = reactions.patches;
-  const std::vector<ns::PatchKind> kinds = ns::airflow_patch_kinds(part.piece.mesh);
+  const std::vector<ns::PatchKind> kinds = ns::airflow_patch_kinds(part.piece.mesh, job.drive);
   BoundaryShear shear{ns::consistent_wall_shear(part.piece.mesh, reactions, kinds),
                       std::move(stress.shear)};
   patch_shear(part.piece.mesh, shear.consistent, stress.patches);
@@ -256,8 +271,9 @@ Partition partition(HybridMesh mesh, int rank, int ranks) {
 }
 
 void write_airflow_outputs(const AirflowJob& job, Partition& part, const PieceSolves& solves,
-                           const ns::FlowField& field, AirflowResult& r) {
-  const BoundaryShear shear = flow_results(job, part, solves, field, r);
+                           const ns::FlowField& field, const PatchOpenings& openings,
+                           AirflowResult& r) {
+  const BoundaryShear shear = flow_results(job, part, solves, field, openings, r);
   // Files, in millimetres again.
   for (auto& x : part.piece.mesh.nodes) x *= r.d_in_mm;
   for (auto& x : part.surface.nodes) x *= r.d_in_mm;
@@ -324,6 +340,15 @@ void write_summary_json(const AirflowJob& job, AirflowResult& r) {
                      {"preconditioner_builds", s.preconditioner_builds},
                      {"residual", significant(s.residual, 7)},
                      {"seconds", significant(s.seconds, 6)}});
+  Json openings = Json::array();
+  for (const auto& o : r.openings)
+    openings.push_back(
+        {{"area_mm2", significant(o.area_mm2)},
+         {"centroid_mm",
+          {significant(o.centroid_mm[0]), significant(o.centroid_mm[1]),
+           significant(o.centroid_mm[2])}},
+         {"flow_ml_s", significant(o.flow_ml_s)},
+         {"share", significant(r.inlet_flow_ml_s != 0.0 ? o.flow_ml_s / r.inlet_flow_ml_s : 0.0)}});
   const Json summary = {
       {"mesh", job.mesh.string()},
       {"cells", r.cells},
@@ -337,10 +362,16 @@ void write_summary_json(const AirflowJob& job, AirflowResult& r) {
       {"reynolds_defined_on", "d_in = 4A/P with P the inlet outline as meshed (raw)"},
       {"viscosity_m2_s", significant(job.viscosity)},
       {"density_kg_m3", significant(job.density)},
+      {"drive", drive_name(job)},
       {"inlet_profile", profile_name(job)},
       {"flow_ml_s", significant(r.flow_ml_s)},
+      {"inlet_flow_ml_s", significant(r.inlet_flow_ml_s)},
       {"outlet_flow_ml_s", significant(r.outlet_flow_ml_s)},
+      {"openings", openings},
       {"pressure_drop_pa", significant(r.pressure_drop_pa)},
+      // Driven at the outlet: from the still air (total pressure 0) to the outlet's mean.
+      {"pressure_drop_from_ambient_pa",
+       job.drive == ns::DrivenPatch::outlet ? significant(r.ambient_drop_pa) : Json(nullptr)},
       {"resistance_pa_s_ml", significant(r.resistance)},
       {"max_speed_m_s", significant(r.max_speed)},
       {"patches", patches},
@@ -363,12 +394,24 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
     if (p.name == "wall") wall = p;
   int picard = 0;
   for (const auto& s : r.steps) picard += s.iterations;
+  std::string openings;
+  if (r.openings.size() > 1) {
+    openings = "\n  openings ";
+    for (std::size_t k = 0; k < r.openings.size(); ++k) {
+      const auto& o = r.openings[k];
+      openings += fmt::format(
+          "{}{}: {:.1f} mm² at ({:.1f}, {:.1f}, {:.1f}) mm, {:.2f} mL/s ({:.1f} %)", k ? "; " : " ",
+          k + 1, o.area_mm2, o.centroid_mm[0], o.centroid_mm[1], o.centroid_mm[2], o.flow_ml_s,
+          r.inlet_flow_ml_s != 0.0 ? 100.0 * o.flow_ml_s / r.inlet_flow_ml_s : 0.0);
+    }
+  }
+  const bool outlet_driven = job.drive == ns::DrivenPatch::outlet;
   return fmt::format(
       "naris solve: {} ({} cells, {} nodes)\n"
-      "  inlet     A {:.2f} mm², P {:.2f} mm, d_in = 4A/P {:.3f} mm; {} profile\n"
+      "  inlet     A {:.2f} mm², P {:.2f} mm, d_in = 4A/P {:.3f} mm; {} profile at the {}\n"
       "  scales    Re {:.1f}, U_in {:.4f} m/s, ν {:.3g} m²/s, ρ {:.3g} kg/m³\n"
-      "  flow      {:.2f} mL/s in, {:.2f} mL/s out\n"
-      "  pressure  drop inlet→outlet {:.3f} Pa; resistance {:.4f} Pa·s/mL\n"
+      "  flow      {:.2f} mL/s in, {:.2f} mL/s out; {:.2f} mL/s imposed {} the {}{}\n"
+      "  pressure  drop inlet→outlet {:.3f} Pa; resistance {:.4f} Pa·s/mL{}\n"
       "  speed     max {:.3f} m/s\n"
       "  wall      shear stress mean {:.4f} Pa, max {:.4f} Pa; force {:.3e} N (surface "
       "integral {:.3e} N); momentum balance {:.1e}\n"
@@ -376,10 +419,13 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
       "per unknown)\n"
       "  wrote     {}",
       job.mesh.filename().string(), r.cells, r.nodes, r.inlet_area_mm2, r.inlet_perimeter_mm,
-      r.d_in_mm, profile_name(job), r.reynolds, r.u_in, job.viscosity, job.density, r.flow_ml_s,
-      r.outlet_flow_ml_s, r.pressure_drop_pa, r.resistance, r.max_speed, wall.mean_shear,
-      wall.max_shear, wall.force.norm(), (wall.pressure_force + wall.viscous_force).norm(),
-      r.momentum_balance, r.steps.size(), picard, r.seconds,
+      r.d_in_mm, profile_name(job), drive_name(job), r.reynolds, r.u_in, job.viscosity, job.density,
+      r.inlet_flow_ml_s, r.outlet_flow_ml_s, r.flow_ml_s, outlet_driven ? "out of" : "into",
+      drive_name(job), openings, r.pressure_drop_pa, r.resistance,
+      outlet_driven ? fmt::format("; from the still air {:.3f} Pa", r.ambient_drop_pa) : "",
+      r.max_speed, wall.mean_shear, wall.max_shear, wall.force.norm(),
+      (wall.pressure_force + wall.viscous_force).norm(), r.momentum_balance, r.steps.size(), picard,
+      r.seconds,
       r.ranks > 1 ? fmt::format("{:.0f} MB per rank, {:.0f} MB on {} ranks",
                                 megabytes(r.peak_memory), megabytes(r.total_peak_memory), r.ranks)
                   : fmt::format("{:.0f} MB", megabytes(r.peak_memory)),

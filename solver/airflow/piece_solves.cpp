@@ -14,13 +14,14 @@
 namespace naris::airflow {
 
 PieceSolves::PieceSolves(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
-                         ns::FlowProblem problem, int inlet, int outlet, SolutionState scales,
-                         RunFiles files)
+                         ns::FlowProblem problem, int inlet, int outlet, ns::DrivenPatch driven,
+                         SolutionState scales, RunFiles files)
     : piece_(piece),
       numbering_(numbering),
       problem_(std::move(problem)),
       inlet_(inlet),
       outlet_(outlet),
+      driven_(driven),
       scales_(scales),
       files_(std::move(files)) {
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank_);
@@ -88,17 +89,41 @@ double PieceSolves::max_speed(const ns::FlowField& f) const {
   return m;
 }
 
-double PieceSolves::outlet_flux(const ns::FlowField& f) const {
-  double flux = ns::patch_flux(piece_, f.velocity, outlet_);
+double PieceSolves::outlet_pressure(const ns::FlowField& f) const {
+  const ns::PatchIntegral out = ns::patch_integral(piece_, f.pressure, outlet_);
+  double sums[2] = {out.integral, out.area};
+  MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+  return sums[0] / sums[1];
+}
+
+double PieceSolves::flux_out(const ns::FlowField& f, int patch) const {
+  double flux = ns::patch_flux(piece_, f.velocity, patch);
   MPI_Allreduce(MPI_IN_PLACE, &flux, 1, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
   return flux;
+}
+
+std::vector<double> PieceSolves::opening_inflows(const ns::FlowField& f,
+                                                 const std::vector<int>& opening,
+                                                 std::size_t openings,
+                                                 const std::vector<std::size_t>& face_index) const {
+  std::vector<double> inflow(openings, 0.0);
+  std::size_t local = 0;
+  for_each_boundary_face(piece_, [&](std::span<const NodeId> v, int) {
+    const std::size_t whole = face_index.empty() ? local : face_index[local];
+    ++local;
+    const int k = opening[whole];
+    if (k >= 0) inflow[static_cast<std::size_t>(k)] -= ns::face_flux(piece_, f.velocity, v);
+  });
+  MPI_Allreduce(MPI_IN_PLACE, inflow.data(), static_cast<int>(openings), MPI_DOUBLE, MPI_SUM,
+                PETSC_COMM_WORLD);
+  return inflow;
 }
 
 ns::Reactions PieceSolves::reaction_forces(const ns::FlowField& f, double reynolds) const {
   ns::FlowProblem problem = problem_;
   problem.reynolds = reynolds;
-  return ns::reaction_forces(piece_, numbering_, f, problem, ns::airflow_patch_kinds(piece_),
-                             PETSC_COMM_WORLD);
+  return ns::reaction_forces(piece_, numbering_, f, problem,
+                             ns::airflow_patch_kinds(piece_, driven_), PETSC_COMM_WORLD);
 }
 
 Eigen::Vector3d PieceSolves::momentum_outflow(const ns::FlowField& f) const {

@@ -23,7 +23,8 @@ class PieceSolves final : public continuation::SteadySolves {
   // `problem` holds the piece's conditions; its Reynolds number is set for each solve.
   // `scales`: what every solution file of the run carries besides its field and Re.
   PieceSolves(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
-              ns::FlowProblem problem, int inlet, int outlet, SolutionState scales, RunFiles files);
+              ns::FlowProblem problem, int inlet, int outlet, ns::DrivenPatch driven,
+              SolutionState scales, RunFiles files);
 
   ns::FlowField solve(double reynolds, const nonlinear::NonlinearOptions& options,
                       const ns::FlowField* initial,
@@ -37,10 +38,16 @@ class PieceSolves final : public continuation::SteadySolves {
   void giving_up(const std::vector<continuation::ContinuationStep>& steps) override;
 
   // Nondimensional, collective: the inlet→outlet drop of the area-averaged pressure, the
-  // largest speed, and the flux out through the outlet.
+  // outlet's area-averaged pressure, the largest speed, the flux out through a patch, and the
+  // flux in through each opening of the inlet (`opening`: per boundary face of the whole mesh,
+  // mesh/patches/patches.h).
   double pressure_drop(const ns::FlowField& f) const;
+  double outlet_pressure(const ns::FlowField& f) const;
   double max_speed(const ns::FlowField& f) const;
-  double outlet_flux(const ns::FlowField& f) const;
+  double flux_out(const ns::FlowField& f, int patch) const;
+  std::vector<double> opening_inflows(const ns::FlowField& f, const std::vector<int>& opening,
+                                      std::size_t openings,
+                                      const std::vector<std::size_t>& face_index) const;
   // The forces of the fluid at `reynolds` by the consistent method (ns/reaction_force.h), and
   // the momentum the flow carries out through the inlet and the
   // outlet; nondimensional, collective.
@@ -55,6 +62,7 @@ class PieceSolves final : public continuation::SteadySolves {
   const parallel::NodeNumbering& numbering_;
   ns::FlowProblem problem_;
   int inlet_, outlet_;
+  ns::DrivenPatch driven_;
   SolutionState scales_;
   RunFiles files_;
   int rank_ = 0;

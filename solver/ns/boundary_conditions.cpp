@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
+#include <utility>
 
 #include "core/error.h"
 
@@ -17,10 +18,17 @@ struct InletGeometry {
   InletSummary summary;
 };
 
-InletGeometry inlet_geometry(const HybridMesh& mesh) {
-  const int inlet = mesh.patch_id("inlet"), outlet = mesh.patch_id("outlet");
+// The driven patch's faces, its unknown nodes and its rim (the nodes of every patch but the
+// inlet and the outlet).
+InletGeometry inlet_geometry(const HybridMesh& mesh, DrivenPatch driven = DrivenPatch::inlet) {
+  int inlet = mesh.patch_id("inlet"), outlet = mesh.patch_id("outlet");
   if (inlet < 0) fail("the mesh has no 'inlet' patch (mesh it with --inlet)");
   if (outlet < 0) fail("the mesh has no 'outlet' patch (mesh it with --outlet)");
+  const char* name = "inlet";
+  if (driven == DrivenPatch::outlet) {
+    std::swap(inlet, outlet);
+    name = "outlet";
+  }
   InletGeometry g;
   g.rim.assign(mesh.nodes.size(), 0);
   std::vector<char> on_inlet(mesh.nodes.size(), 0);
@@ -47,14 +55,16 @@ InletGeometry inlet_geometry(const HybridMesh& mesh) {
     }
   };
   for_each_boundary_face(mesh, visit);
-  if (g.faces.empty()) fail("the 'inlet' patch has no faces");
-  if (!has_outlet) fail("the 'outlet' patch has no faces");
+  if (g.faces.empty()) fail("the '{}' patch has no faces", name);
+  if (!has_outlet)
+    fail("the '{}' patch has no faces", driven == DrivenPatch::outlet ? "inlet" : "outlet");
   g.summary.area = area_normal.norm();
   g.summary.normal = -area_normal / g.summary.area;  // boundary faces point out: flip inward
   g.summary.centroid = moment / g.summary.area;
   for (std::size_t n = 0; n < on_inlet.size(); ++n)
     if (on_inlet[n] && !g.rim[n]) g.nodes.push_back(static_cast<NodeId>(n));
-  if (g.nodes.empty()) fail("the 'inlet' patch has no node off its rim: it is too small to feed");
+  if (g.nodes.empty())
+    fail("the '{}' patch has no node off its rim: it is too small to carry the flow", name);
   return g;
 }
 
@@ -124,7 +134,9 @@ FaceSystem face_system(const HybridMesh& mesh, const InletGeometry& g) {
   return s;
 }
 
-DirichletConditions assemble(const InletGeometry& g, const Eigen::VectorXd& speed) {
+// `sign` +1: along the inward normal (into the domain); −1: out of it.
+DirichletConditions assemble(const InletGeometry& g, const Eigen::VectorXd& speed,
+                             double sign = 1.0) {
   DirichletConditions bc;
   for (std::size_t n = 0; n < g.rim.size(); ++n)
     if (g.rim[n]) {
@@ -133,7 +145,7 @@ DirichletConditions assemble(const InletGeometry& g, const Eigen::VectorXd& spee
     }
   for (std::size_t k = 0; k < g.nodes.size(); ++k) {
     bc.nodes.push_back(g.nodes[k]);
-    bc.values.push_back(speed[static_cast<Eigen::Index>(k)] * g.summary.normal);
+    bc.values.push_back(sign * speed[static_cast<Eigen::Index>(k)] * g.summary.normal);
   }
   return bc;
 }
@@ -142,9 +154,9 @@ DirichletConditions assemble(const InletGeometry& g, const Eigen::VectorXd& spee
 
 DirichletConditions airflow_conditions(const HybridMesh& mesh, InletProfile profile,
                                        double mean_speed, InletSummary* summary,
-                                       const ProfileShape& shape) {
+                                       const ProfileShape& shape, DrivenPatch driven) {
   if (!std::isfinite(mean_speed)) fail("the inlet speed is not finite");
-  InletGeometry g = inlet_geometry(mesh);
+  InletGeometry g = inlet_geometry(mesh, driven);
   const FaceSystem s = face_system(mesh, g);
   Eigen::VectorXd speed = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(g.nodes.size()));
   if (profile == InletProfile::developed) {
@@ -171,7 +183,7 @@ DirichletConditions airflow_conditions(const HybridMesh& mesh, InletProfile prof
   speed *= mean_speed * g.summary.area / s.load.dot(speed);
   g.summary.flux = s.load.dot(speed);
   if (summary) *summary = g.summary;
-  return assemble(g, speed);
+  return assemble(g, speed, driven == DrivenPatch::outlet ? -1.0 : 1.0);
 }
 
 DirichletConditions airflow_conditions(const HybridMesh& mesh,

@@ -4,14 +4,27 @@
 // ranks that share it.
 #include <mpi.h>
 
+#include <vector>
+
 #include "solver/ns/flow_field.h"
 
 namespace naris::ns {
 
-// Outflow stabilization (Bazilevs et al. 2009) on one patch, the outlet: −β ∫ (u·n)₋ u·w.
+// The term −β ∫ (u·n)₋ u·w (backflow.h) on the natural patches. On an outlet, β = 1 stabilizes
+// backflow (Bazilevs et al. 2009); on an opening to still air, β = ½ makes the traction
+// p = −½ (u·n)², the total pressure of air drawn in from rest (docs/method/boundary-conditions.md).
 struct BackflowStabilization {
-  int patch = -1;  // −1: none
-  double beta = 1.0;
+  struct Patch {
+    int patch = -1;
+    double beta = 1.0;
+  };
+  std::vector<Patch> patches;
+  // β on `patch`, 0 where the term is not applied.
+  double beta(int patch) const {
+    for (const Patch& p : patches)
+      if (p.patch == patch) return p.beta;
+    return 0.0;
+  }
 };
 
 struct FlowProblem {

@@ -13,10 +13,7 @@ namespace naris::ns {
 OseenSystem::OseenSystem(const HybridMesh& mesh, const parallel::NodeNumbering& numbering,
                          MPI_Comm comm, const std::string& prefix,
                          const BackflowStabilization& backflow, MatType type)
-    : mesh_(mesh),
-      numbering_(numbering),
-      backflow_patch_(backflow.patch),
-      backflow_beta_(backflow.beta) {
+    : mesh_(mesh), numbering_(numbering), backflow_(backflow) {
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -146,7 +143,7 @@ void OseenSystem::assemble(const std::vector<Eigen::Vector3d>& advection,
   assemble_cells<fem::Hex8>(mesh_.hexes, owned_hexes_, advection, pressure, nu, f, linearization);
   insertion_->end();
   // The piece holds the boundary faces this rank owns.
-  if (backflow_patch_ >= 0) assemble_backflow(advection, linearization);
+  if (!backflow_.patches.empty()) assemble_backflow(advection, linearization);
   petsc::check(MatAssemblyBegin(matrix_, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
   petsc::check(MatAssemblyEnd(matrix_, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
   for (Vec v : {rhs_.get(), residual_.get()}) {
@@ -158,7 +155,7 @@ void OseenSystem::assemble(const std::vector<Eigen::Vector3d>& advection,
 void OseenSystem::assemble_backflow(const std::vector<Eigen::Vector3d>& advection,
                                     Linearization linearization) {
   const bool newton = linearization == Linearization::newton;
-  auto face = [&](std::span<const NodeId> v) {
+  auto face = [&](std::span<const NodeId> v, double beta) {
     const int m = static_cast<int>(v.size());
     const auto node = [&](int i) {
       return static_cast<std::size_t>(v[static_cast<std::size_t>(i)]);
@@ -167,7 +164,7 @@ void OseenSystem::assemble_backflow(const std::vector<Eigen::Vector3d>& advectio
     // Newton's share, d/du of the term with a = u: −β ∫ H(−u·n) (δu·n) (u·w); rows and
     // columns (4i + c) like PETSc's block.
     Eigen::Matrix<double, 16, 16> D;
-    backflow_face(mesh_, v, advection, backflow_beta_, M, newton ? &D : nullptr);
+    backflow_face(mesh_, v, advection, beta, M, newton ? &D : nullptr);
     if (M.isZero()) return;
     // PETSc reads the (4m)×(4m) block row-major: velocity components on the block diagonal.
     std::array<double, 16 * 16> block{};
@@ -193,7 +190,8 @@ void OseenSystem::assemble_backflow(const std::vector<Eigen::Vector3d>& advectio
                    "VecSetValuesBlocked");
   };
   for_each_boundary_face(mesh_, [&](std::span<const NodeId> v, int patch) {
-    if (patch == backflow_patch_) face(v);
+    const double beta = backflow_.beta(patch);
+    if (beta != 0.0) face(v, beta);
   });
 }
 

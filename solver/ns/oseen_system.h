@@ -94,8 +94,7 @@ class OseenSystem {
 
   const HybridMesh& mesh_;
   const parallel::NodeNumbering& numbering_;
-  int backflow_patch_ = -1;
-  double backflow_beta_ = 0.0;
+  BackflowStabilization backflow_;
   petsc::Matrix matrix_;
   std::optional<parallel::BlockAssembly> insertion_;  // the cells' matrices into matrix_
   int rank_ = 0;

@@ -4,13 +4,17 @@
 
 namespace naris::ns {
 
+double face_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u,
+                 std::span<const NodeId> v) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (NodeId n : v) mean += u[static_cast<std::size_t>(n)];
+  return polygon_vector_area(mesh, v).dot(mean) / static_cast<double>(v.size());
+}
+
 double patch_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u, int patch) {
   double flux = 0.0;
   for_each_boundary_face(mesh, [&](std::span<const NodeId> v, int id) {
-    if (id != patch) return;
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (NodeId n : v) mean += u[static_cast<std::size_t>(n)];
-    flux += polygon_vector_area(mesh, v).dot(mean) / static_cast<double>(v.size());
+    if (id == patch) flux += face_flux(mesh, u, v);
   });
   return flux;
 }

@@ -8,6 +8,9 @@
 
 namespace naris::ns {
 
+// ∫ u·n dA over one boundary face `v` (n outward).
+double face_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u,
+                 std::span<const NodeId> v);
 // ∫ u·n dA over the faces of `patch` (n outward).
 double patch_flux(const HybridMesh& mesh, const std::vector<Eigen::Vector3d>& u, int patch);
 // ∫ u (u·n) dA over the faces of `patch` (n outward): the momentum the flow carries out.

@@ -59,11 +59,14 @@ void add_cell_residuals(const HybridMesh& piece, const parallel::NodeNumbering& 
 
 }  // namespace
 
-std::vector<PatchKind> airflow_patch_kinds(const HybridMesh& mesh) {
+std::vector<PatchKind> airflow_patch_kinds(const HybridMesh& mesh, DrivenPatch driven) {
   std::vector<PatchKind> kinds(mesh.patch_names.size(), PatchKind::wall);
+  const bool from_inlet = driven == DrivenPatch::inlet;
   for (std::size_t q = 0; q < kinds.size(); ++q) {
-    if (mesh.patch_names[q] == "inlet") kinds[q] = PatchKind::prescribed;
-    if (mesh.patch_names[q] == "outlet") kinds[q] = PatchKind::natural;
+    if (mesh.patch_names[q] == "inlet")
+      kinds[q] = from_inlet ? PatchKind::prescribed : PatchKind::natural;
+    if (mesh.patch_names[q] == "outlet")
+      kinds[q] = from_inlet ? PatchKind::natural : PatchKind::prescribed;
   }
   return kinds;
 }
@@ -131,14 +134,15 @@ Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering
     }
   });
 
-  // The outflow stabilization's term B_i (backflow.h) is the outlet's traction on the fluid,
-  // −B_i against N_i: the outlet bears Σ B_i, and a wall node on its rim R_i + B_i.
+  // The backflow term B_i (backflow.h) is a natural patch's traction on the fluid, −B_i against
+  // N_i: the patch bears Σ B_i, and a wall node on its rim R_i + B_i.
   std::vector<double> force(3 * static_cast<std::size_t>(patches), 0.0);
-  if (problem.backflow.patch >= 0) {
+  if (!problem.backflow.patches.empty()) {
     Eigen::Matrix4d M;
     for_each_boundary_face(piece, [&](std::span<const NodeId> v, int patch) {
-      if (patch != problem.backflow.patch) return;
-      backflow_face(piece, v, field.velocity, problem.backflow.beta, M, nullptr);
+      const double beta = problem.backflow.beta(patch);
+      if (beta == 0.0) return;
+      backflow_face(piece, v, field.velocity, beta, M, nullptr);
       for (std::size_t i = 0; i < v.size(); ++i) {
         Eigen::Vector3d b = Eigen::Vector3d::Zero();
         for (std::size_t j = 0; j < v.size(); ++j)

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mesh/hybrid_mesh.h"
+#include "solver/ns/boundary_conditions.h"
 #include "solver/ns/flow_problem.h"
 #include "solver/parallel/partition.h"
 
@@ -19,12 +20,13 @@ namespace naris::ns {
 enum class PatchKind {
   wall,        // no slip: the traction is the unknown reaction
   prescribed,  // velocity given (an inlet): the traction is a reaction too
-  natural,     // traction-free (the outlet): zero traction by the weak form
+  natural,     // traction-free (the outlet), or the backflow term's traction alone
 };
 
-// The airflow problem's kinds (boundary_conditions.h): `inlet` prescribed, `outlet` natural,
-// every other patch a wall.
-std::vector<PatchKind> airflow_patch_kinds(const HybridMesh& mesh);
+// The airflow problem's kinds (boundary_conditions.h): the driven one of `inlet` and `outlet`
+// prescribed, the other natural, every other patch a wall.
+std::vector<PatchKind> airflow_patch_kinds(const HybridMesh& mesh,
+                                           DrivenPatch driven = DrivenPatch::inlet);
 
 struct Reactions {
   // Per patch id, the nondimensional force (units ρU²d²) the fluid exerts on the patch, summed
@@ -39,7 +41,7 @@ struct Reactions {
 // The reactions of the converged field; the forces are summed over the ranks of `comm`. `field` and
 // `problem` are the piece's (local numbers, its Dirichlet conditions); a node shared by patches
 // gives a prescribed patch the surface integral of the traction against its basis function there, a
-// natural patch nothing but the outflow stabilization's traction (`problem.backflow`), and the
+// natural patch nothing but the backflow term's traction (`problem.backflow`), and the
 // walls the rest, in proportion to ∫ N_i over each. Collective.
 Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
                           const FlowField& field, const FlowProblem& problem,

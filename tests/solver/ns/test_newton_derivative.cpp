@@ -56,7 +56,8 @@ std::array<double, 2> derivative_error(double reynolds) {
   const HybridMesh mesh = pipe();
   const std::size_t n = mesh.nodes.size();
   const parallel::NodeNumbering numbering = parallel::whole_numbering(n);
-  const BackflowStabilization backflow{mesh.patch_id("outlet"), 1.0};
+  const int outlet = mesh.patch_id("outlet");
+  const BackflowStabilization backflow{{{outlet, 1.0}}};
   OseenSystem system(mesh, numbering, PETSC_COMM_SELF, "fd_", backflow, MATBAIJ);
   system.use_newton_operator({});
   const double nu = 1.0 / reynolds;
@@ -65,7 +66,7 @@ std::array<double, 2> derivative_error(double reynolds) {
   // through others.
   int in = 0, out = 0;
   for_each_boundary_face(mesh, [&](std::span<const NodeId> v, std::int32_t patch) {
-    if (patch != backflow.patch) return;
+    if (patch != outlet) return;
     Vec3 u = Vec3::Zero();
     for (NodeId k : v) u += x.velocity[static_cast<std::size_t>(k)];
     (u[2] < 0.0 ? in : out) += 1;

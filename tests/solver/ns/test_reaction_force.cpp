@@ -86,7 +86,7 @@ Drag drag_at(int across, double re) {
   const DirichletConditions bc = airflow_conditions(mesh, InletProfile::developed, 1.0);
   nonlinear::NonlinearReport report;
   // With the outlet's outflow stabilization, as naris solve has it.
-  const FlowProblem problem{re, {}, bc, {mesh.patch_id("outlet"), 1.0}};
+  const FlowProblem problem{re, {}, bc, {{{mesh.patch_id("outlet"), 1.0}}}};
   const FlowField f = nonlinear::solve_navier_stokes(mesh, problem, {}, &report);
   EXPECT_TRUE(report.converged) << across << " cells across";
   const std::vector<Eigen::Vector3d> forces =

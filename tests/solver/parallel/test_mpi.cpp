@@ -108,7 +108,7 @@ TEST(Mpi, ReactionForcesOfThePiecesAreTheWholeMeshs) {
   const FlowProblem problem{100.0,
                             {},
                             airflow_conditions(whole, InletProfile::uniform, 1.0),
-                            {whole.patch_id("outlet"), 1.0}};
+                            {{{whole.patch_id("outlet"), 1.0}}}};
   const std::vector<PatchKind> kinds = airflow_patch_kinds(whole);
   const Reactions whole_reactions = reaction_forces(
       whole, parallel::whole_numbering(whole.nodes.size()), field, problem, kinds, PETSC_COMM_SELF);
