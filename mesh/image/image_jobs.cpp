@@ -167,7 +167,9 @@ Json nasal_sidecar(const SegmentJob& job, const NasalAirway& nasal, const fs::pa
                {"side", nasal_side_name(job.side)},
                {"nasopharynx", job.keep_nasopharynx ? "keep" : "cut"},
                {"threshold_hu", significant(nasal.threshold, 5)},
+               {"wall_hu", significant(nasal.wall_level, 5)},
                {"volume_ml", significant(nasal.volume_ml, 5)},
+               {"wall_layer_ml", significant(nasal.wall_layer_ml, 5)},
                {"sinus_ml", significant(nasal.sinus_ml, 5)},
                {"sinuses", nasal.sinuses},
                {"room_ml", significant(nasal.room_ml, 5)},
@@ -315,12 +317,13 @@ std::string format_segment_summary(const SegmentJob& job, const SegmentJobResult
                       n.right ? "right" : "left", n.area, n.centre[0], n.centre[1], n.centre[2]);
     return fmt::format(
         "naris segment: {} ({}, {}), nasal airway, {} side(s), nasopharynx {}\n  threshold {:.1f} "
-        "HU ({})\n  airway {:.2f} mL; left out: {} sinus cavities ({:.1f} mL), room air {:.0f} "
+        "HU ({}), wall at {:.1f} HU\n  airway {:.2f} mL ({:.2f} mL of it the wall's layer); left "
+        "out: {} sinus cavities ({:.1f} mL), room air {:.0f} "
         "mL{}{}\n  inlet {}\n  outlet {}\n  time {:.2f} s\n  wrote {}, {} and {}",
         job.input.filename().string(), dims_text(r.frame), spacing_text(r.frame),
         nasal_side_name(job.side), job.keep_nasopharynx ? "kept" : "cut", r.threshold,
-        job.threshold == "auto" ? "automatic" : "given", a.volume_ml, a.sinuses, a.sinus_ml,
-        a.room_ml,
+        job.threshold == "auto" ? "automatic" : "given", a.wall_level, a.volume_ml, a.wall_layer_ml,
+        a.sinuses, a.sinus_ml, a.room_ml,
         a.masked_voxels ? fmt::format("; {} masked voxels taken for tissue", a.masked_voxels) : "",
         nares, a.inlet, a.outlet.empty() ? "(none: give one to the mesher)" : a.outlet, r.seconds,
         job.output.string(), segmentation_sidecar(job.output).string(),

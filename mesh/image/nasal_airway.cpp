@@ -535,6 +535,30 @@ Mask select_side(const ImageFrame& frame, const VoxelGrid& g, const Mask& nasal,
   return flood(g, nares.of(o.side).front()->voxels, keep);
 }
 
+// The wall's partial-volume layer: voxels between the threshold and `wall_level` that touch the
+// airway and no other air (a sinus, the other side, the room) join it. The threshold decides what
+// connects to what; this moves the wall out by at most a voxel, where the experts draw it.
+std::size_t add_wall_layer(const Volume<float>& ct, const VoxelGrid& g, const Mask& tissue,
+                           float threshold, float wall_level, int ap, Mask& airway) {
+  int lo = g.n[ap], hi = -1;  // the airway's extent along A-P: nothing added past its cuts
+  for (std::size_t q = 0; q < g.size(); ++q)
+    if (airway[q]) lo = std::min(lo, g.coord(q, ap)), hi = std::max(hi, g.coord(q, ap));
+  std::vector<std::size_t> layer;
+  for (std::size_t q = 0; q < g.size(); ++q) {
+    const float h = ct.values[q];
+    if (airway[q] || h < threshold || h >= wall_level) continue;
+    if (g.coord(q, ap) < lo || g.coord(q, ap) > hi) continue;
+    bool touches = false, other_air = false;
+    g.neighbours(q, [&](std::size_t r, int, int) {
+      touches |= airway[r] != 0;
+      other_air |= !tissue[r] && !airway[r];
+    });
+    if (touches && !other_air) layer.push_back(q);
+  }
+  for (std::size_t q : layer) airway[q] = 1;
+  return layer.size();
+}
+
 // The inlet: the area-weighted plane of the openings. They are caps that bulge into the
 // vestibule where the room air reaches in (a wide nostril lets the closing's balls in), so the
 // plane goes in past the deepest tenth of their faces by kLumenDepth, where the vestibule is one
@@ -571,10 +595,6 @@ const char* nasal_side_name(NasalSide side) {
   return names[static_cast<int>(side)];
 }
 
-double nasal_airway_threshold(const Volume<float>& ct) {
-  return 0.5 * air_threshold(ct);
-}
-
 NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptions& o) {
   if (!(o.closing_radius > 0.0)) fail("the closing radius must be positive");
   if (!(o.sinus_margin > 0.0) || !(o.ethmoid_margin > 0.0))
@@ -585,7 +605,15 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
   const double voxel_ml = frame.spacing.prod() / 1000.0;
   const PatientAxes axes = patient_axes(frame);
   NasalAirway out;
-  out.threshold = o.threshold ? *o.threshold : nasal_airway_threshold(ct);
+  if (o.threshold) {
+    out.threshold = out.wall_level = *o.threshold;
+  } else {
+    // Partial-volume voxels of the narrow meatuses still pass half-way from the histogram's
+    // air–tissue valley to water (0 HU); the wall is drawn 60 % of the way.
+    const double valley = air_threshold(ct);
+    out.threshold = 0.5 * valley;
+    out.wall_level = 0.4 * valley;
+  }
   out.ap_axis = axes.axis[1];
 
   Mask tissue(n);
@@ -618,6 +646,10 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
   out.sinus_ml = static_cast<double>(sinus_count) * voxel_ml;
 
   Mask result = select_side(frame, g, nasal, depth, nares, o, axes, out);
+  out.wall_layer_ml = static_cast<double>(add_wall_layer(
+                          ct, g, tissue, static_cast<float>(out.threshold),
+                          static_cast<float>(out.wall_level), axes.axis[1], result)) *
+                      voxel_ml;
   // Air cut by the scan's border is closed there by a wall: no stray open patch for the mesher.
   for (std::size_t q = 0; q < n; ++q)
     for (int a = 0; a < 3; ++a)

@@ -19,7 +19,9 @@ NasalSide parse_nasal_side(const std::string& text);
 const char* nasal_side_name(NasalSide side);
 
 struct NasalAirwayOptions {
-  std::optional<double> threshold;  // HU; absent: automatic (nasal_airway_threshold)
+  // HU; absent: automatic, half-way from the histogram's air–tissue valley (air_threshold) to
+  // water, with the wall drawn 60 % of the way (NasalAirway::wall_level).
+  std::optional<double> threshold;
   NasalSide side = NasalSide::right;
   // The nasopharynx behind the choana: kept whole, or cut (one side ends at its choana; both
   // sides end a little behind the choanae, where they have joined).
@@ -54,21 +56,19 @@ struct NasalAirway {
   Volume<std::uint8_t> mask;     // 1: the airway
   Volume<std::uint8_t> regions;  // AirwayRegion per voxel
   double threshold = 0.0;
-  std::vector<Naris> nares;   // those the airway is entered by (one, or both)
-  std::string inlet;          // cut plane p=…;n=… (mm) across the nares
-  std::string outlet;         // cut plane: the choana, or the nasopharynx's cut (or none)
-  std::optional<int> choana;  // the last slice before the sides join, along the A-P axis
-  int ap_axis = 1;            // the image axis closest to anterior–posterior
+  double wall_level = 0.0;     // HU: the wall's partial-volume layer lies between it and threshold
+  double wall_layer_ml = 0.0;  // of the airway, the wall's layer added at wall_level
+  std::vector<Naris> nares;    // those the airway is entered by (one, or both)
+  std::string inlet;           // cut plane p=…;n=… (mm) across the nares
+  std::string outlet;          // cut plane: the choana, or the nasopharynx's cut (or none)
+  std::optional<int> choana;   // the last slice before the sides join, along the A-P axis
+  int ap_axis = 1;             // the image axis closest to anterior–posterior
   double volume_ml = 0.0;
   double sinus_ml = 0.0;          // air reached from the nares and left out as sinus
   double room_ml = 0.0;           // room air (outside the body)
   std::size_t sinuses = 0;        // cavities left out
   std::size_t masked_voxels = 0;  // de-identification masks taken for tissue
 };
-
-// The level between air and soft tissue that partial-volume voxels of the narrow meatuses still
-// pass: half-way from the histogram's air–tissue valley (air_threshold) to water (0 HU).
-double nasal_airway_threshold(const Volume<float>& ct);
 
 // Throws naris::Error, with a message for a person, when the CT has no air inside the body,
 // no naris is found, the requested side has no naris, or the sides cannot be separated.

@@ -1,7 +1,8 @@
 // The nasal airway of the NasalSeg head CTs (Data: NasalSeg (Zhang et al., 2024), CC BY 4.0)
 // against their expert labels, on each scan's own grid: Dice, volume ratio and the mean
 // symmetric surface distance for the right cavity (label 3) and for both cavities with the
-// nasopharynx (labels 3, 4, 5), with the time of each segmentation.
+// nasopharynx (labels 3, 4, 5), with the time of each segmentation; then each case's stages
+// from the CT to the mesh as `naris run cases/nasalseg-*` takes them, timed.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -11,8 +12,10 @@
 
 #include "core/log.h"
 #include "mesh/image/distance_transform.h"
+#include "mesh/image/image_jobs.h"
 #include "mesh/image/nasal_airway.h"
 #include "mesh/image/read_volume.h"
+#include "mesh/pipeline/mesh_job.h"
 #include "postproc/figures/canvas.h"
 #include "tests/mesh/image/expert_labels.h"
 
@@ -102,6 +105,31 @@ void draw_slices(const Volume<float>& ct, const std::vector<std::uint8_t>& mask,
   canvas.write_png(path);
 }
 
+// The case's stages on one scan (HSR to isotropic slices, the right cavity, the mesh between its
+// naris and choana), in a scratch folder; prints a table row.
+void case_stages(const char* name, const fs::path& ct_file, const fs::path& scratch) {
+  fs::create_directories(scratch);
+  const InterpolateJob interpolate{.input = ct_file, .output = scratch / "interpolated.nrrd"};
+  const InterpolateJobResult i = run_interpolate_job(interpolate);
+  SegmentJob segment;
+  segment.input = interpolate.output;
+  segment.output = scratch / "airway.nrrd";
+  segment.airway = "nasal";
+  const SegmentJobResult s = run_segment_job(segment);
+  MeshJob mesh;
+  mesh.input = segment.output;
+  mesh.label.emplace(1, '1');  // the airway's label
+  mesh.inlet = s.nasal->inlet;
+  mesh.outlet = s.nasal->outlet;
+  mesh.output = scratch / "mesh.h5";
+  Stopwatch clock;
+  MeshJobResult m = run_mesh_job(mesh);
+  write_mesh_outputs(mesh, m);
+  const double t_mesh = clock.seconds();
+  std::printf("| %s | %.2f | %.2f | %.2f | %zu k | %.2f |\n", name, i.seconds, s.seconds, t_mesh,
+              m.mesh.cell_count() / 1000, i.seconds + s.seconds + t_mesh);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -142,6 +170,15 @@ int main(int argc, char** argv) {
         name, right.threshold, r.dice, r.ratio, r.surface_mm, t_right, b.dice, b.ratio,
         b.surface_mm, t_both, both.sinus_ml, right.choana ? *right.choana : -1, expert_choana);
   }
+  std::printf(
+      "\nThe case's stages (naris run cases/nasalseg-*: HSR to isotropic slices, the right "
+      "cavity, the mesh with its files)\n\n");
+  std::printf("| case | interpolate (s) | segment (s) | mesh (s) | cells | total (s) |\n");
+  std::printf("|---|---|---|---|---|---|\n");
+  const fs::path scratch = fs::temp_directory_path() / "naris-bench-anatomy";
+  for (const char* name : {"P005", "P045", "P055"})
+    case_stages(name, dir / (std::string(name) + "_img.nrrd"), scratch / name);
+  fs::remove_all(scratch);
   std::printf("\npeak memory %.0f MB\n", static_cast<double>(peak_memory_bytes()) / 1e6);
   return 0;
 }
