@@ -536,24 +536,31 @@ Mask select_side(const ImageFrame& frame, const VoxelGrid& g, const Mask& nasal,
 }
 
 // The wall's partial-volume layer: voxels between the threshold and `wall_level` that touch the
-// airway and no other air (a sinus, the other side, the room) join it. The threshold decides what
-// connects to what; this moves the wall out by at most a voxel, where the experts draw it.
+// airway and no other air (a sinus, the other side, the room) join it, unless they are a
+// one-voxel wall with airway on both sides (a septal gap, a turbinate's edge would open). The
+// threshold decides what connects to what; this moves the wall out by a voxel, where the
+// experts draw it. Nothing on the scan's border (closed by wall) or past the airway's A-P cuts.
 std::size_t add_wall_layer(const Volume<float>& ct, const VoxelGrid& g, const Mask& tissue,
-                           float threshold, float wall_level, int ap, Mask& airway) {
-  int lo = g.n[ap], hi = -1;  // the airway's extent along A-P: nothing added past its cuts
+                           float wall_level, int ap, Mask& airway) {
+  int lo = g.n[ap], hi = -1;
   for (std::size_t q = 0; q < g.size(); ++q)
     if (airway[q]) lo = std::min(lo, g.coord(q, ap)), hi = std::max(hi, g.coord(q, ap));
   std::vector<std::size_t> layer;
   for (std::size_t q = 0; q < g.size(); ++q) {
-    const float h = ct.values[q];
-    if (airway[q] || h < threshold || h >= wall_level) continue;
+    // Tissue below the wall level; masked voxels are tissue but at the image's minimum.
+    if (airway[q] || !tissue[q] || !(ct.values[q] < wall_level)) continue;
     if (g.coord(q, ap) < lo || g.coord(q, ap) > hi) continue;
-    bool touches = false, other_air = false;
-    g.neighbours(q, [&](std::size_t r, int, int) {
-      touches |= airway[r] != 0;
+    bool on_border = false;
+    for (int a = 0; a < 3; ++a) on_border |= g.coord(q, a) == 0 || g.coord(q, a) + 1 == g.n[a];
+    if (on_border) continue;
+    bool touches = false, other_air = false, between = false;
+    std::array<int, 3> sides{};  // per axis: airway on the -1 side (1), the +1 side (2)
+    g.neighbours(q, [&](std::size_t r, int a, int d) {
+      if (airway[r]) touches = true, sides[a] |= d < 0 ? 1 : 2;
       other_air |= !tissue[r] && !airway[r];
     });
-    if (touches && !other_air) layer.push_back(q);
+    for (int s : sides) between |= s == 3;
+    if (touches && !other_air && !between) layer.push_back(q);
   }
   for (std::size_t q : layer) airway[q] = 1;
   return layer.size();
@@ -646,14 +653,14 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
   out.sinus_ml = static_cast<double>(sinus_count) * voxel_ml;
 
   Mask result = select_side(frame, g, nasal, depth, nares, o, axes, out);
-  out.wall_layer_ml = static_cast<double>(add_wall_layer(
-                          ct, g, tissue, static_cast<float>(out.threshold),
-                          static_cast<float>(out.wall_level), axes.axis[1], result)) *
-                      voxel_ml;
   // Air cut by the scan's border is closed there by a wall: no stray open patch for the mesher.
   for (std::size_t q = 0; q < n; ++q)
     for (int a = 0; a < 3; ++a)
       if (g.coord(q, a) == 0 || g.coord(q, a) + 1 == g.n[a]) result[q] = 0;
+  out.wall_layer_ml =
+      static_cast<double>(
+          add_wall_layer(ct, g, tissue, static_cast<float>(out.wall_level), axes.axis[1], result)) *
+      voxel_ml;
 
   for (const NarisVoxels* c : nares.of(o.side)) {
     out.nares.push_back(c->naris);

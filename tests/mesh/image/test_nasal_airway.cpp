@@ -128,25 +128,27 @@ TEST(NasalAirway, TakesTheWallsPartialVolumeLayerButBridgesToNoOtherAir) {
   ASSERT_LT(a.threshold, a.wall_level);
   const float partial = static_cast<float>(0.5 * (a.threshold + a.wall_level));
   Volume<float> v = plain;
-  for (int k = 22; k < 28; ++k)
+  for (int k = 22; k < 28; ++k) {
     for (int j = 22; j < 38; ++j) v.at(38, j, k) = partial;  // the +i wall's layer: joins
-  for (int k = 22; k < 28; ++k)
-    for (int i = 30; i < 38; ++i) {
-      v.at(i, 21, k) = partial;  // the -j wall's layer, between the cavity ...
-      for (int j = 18; j < 21; ++j) v.at(i, j, k) = air(i, j, k);  // ... and a closed cell
+    for (int j = 30; j < 38; ++j) {
+      v.at(21, j, k) = partial;  // the -i wall's layer, between the cavity ...
+      for (int i = 18; i < 21; ++i) v.at(i, j, k) = air(i, j, k);  // ... and a closed cell
     }
+    for (int j = 22; j < 32; ++j) v.at(30, j, k) = partial;  // a fin with air on both sides
+  }
   const NasalAirway b = segment_nasal_airway(v, NasalAirwayOptions{});
   EXPECT_DOUBLE_EQ(b.threshold, a.threshold);
   EXPECT_NEAR(b.wall_layer_ml - a.wall_layer_ml, 16 * 6 / 1000.0, 1e-9);
-  EXPECT_NEAR(b.volume_ml - a.volume_ml, 16 * 6 / 1000.0, 1e-9);
+  EXPECT_NEAR(b.volume_ml - a.volume_ml, (16 * 6 - 10 * 6) / 1000.0, 1e-9);
   for (int k = 22; k < 28; ++k) {
     EXPECT_EQ(b.mask.at(38, 30, k), 1);
-    EXPECT_EQ(b.mask.at(33, 21, k), 0) << "the layer between the cavity and the cell";
+    EXPECT_EQ(b.mask.at(21, 33, k), 0) << "the layer between the cavity and the cell";
+    EXPECT_EQ(b.mask.at(30, 26, k), 0) << "the fin stays";
   }
   // A threshold given by hand is the wall too: no layer.
   const NasalAirway c = segment_nasal_airway(v, NasalAirwayOptions{.threshold = a.threshold});
   EXPECT_EQ(c.wall_layer_ml, 0.0);
-  EXPECT_NEAR(c.volume_ml, a.volume_ml - a.wall_layer_ml, 1e-9);
+  EXPECT_NEAR(c.volume_ml, b.volume_ml - b.wall_layer_ml, 1e-9);
 }
 
 }  // namespace
