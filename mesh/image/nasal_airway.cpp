@@ -41,6 +41,11 @@ struct VoxelGrid {
   int coord(std::size_t q, int axis) const {
     return static_cast<int>(q / stride[axis] % static_cast<std::size_t>(n[axis]));
   }
+  bool on_border(std::size_t q) const {
+    for (int a = 0; a < 3; ++a)
+      if (coord(q, a) == 0 || coord(q, a) + 1 == n[a]) return true;
+    return false;
+  }
   Eigen::Vector3d ijk(std::size_t q) const {
     return Eigen::Vector3d(coord(q, 0), coord(q, 1), coord(q, 2));
   }
@@ -550,9 +555,7 @@ std::size_t add_wall_layer(const Volume<float>& ct, const VoxelGrid& g, const Ma
     // Tissue below the wall level; masked voxels are tissue but at the image's minimum.
     if (airway[q] || !tissue[q] || !(ct.values[q] < wall_level)) continue;
     if (g.coord(q, ap) < lo || g.coord(q, ap) > hi) continue;
-    bool on_border = false;
-    for (int a = 0; a < 3; ++a) on_border |= g.coord(q, a) == 0 || g.coord(q, a) + 1 == g.n[a];
-    if (on_border) continue;
+    if (g.on_border(q)) continue;
     bool touches = false, other_air = false, between = false;
     std::array<int, 3> sides{};  // per axis: airway on the -1 side (1), the +1 side (2)
     g.neighbours(q, [&](std::size_t r, int a, int d) {
@@ -655,8 +658,7 @@ NasalAirway segment_nasal_airway(const Volume<float>& ct, const NasalAirwayOptio
   Mask result = select_side(frame, g, nasal, depth, nares, o, axes, out);
   // Air cut by the scan's border is closed there by a wall: no stray open patch for the mesher.
   for (std::size_t q = 0; q < n; ++q)
-    for (int a = 0; a < 3; ++a)
-      if (g.coord(q, a) == 0 || g.coord(q, a) + 1 == g.n[a]) result[q] = 0;
+    if (g.on_border(q)) result[q] = 0;
   out.wall_layer_ml =
       static_cast<double>(
           add_wall_layer(ct, g, tissue, static_cast<float>(out.wall_level), axes.axis[1], result)) *
