@@ -83,6 +83,12 @@ MeshSettings::MeshSettings() {
             "'auto' (the naris plane of segment --airway nasal); with an outlet, the part between "
             "the two is kept; alone, the side towards the object's centre");
   table.add("outlet", job.outlet, "outlet cut plane, same forms as inlet ('auto': the choana)");
+  table
+      .add("outlet_extension", job.outlet_extension,
+           "a straight tube of the outlet's section, this many mm long, added beyond an outlet "
+           "along an image axis, so that the flow leaves where the outlet is traction-free (0: "
+           "none)")
+      .non_negative();
   table.add("patch", job.regions,
             "carve a named patch out of the wall: name:box=x0,y0,z0,x1,y1,z1 or "
             "name:sphere=x,y,z,r (mm); repeatable");

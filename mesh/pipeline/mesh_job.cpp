@@ -18,6 +18,7 @@
 #include "mesh/io/mesh_h5.h"
 #include "mesh/io/write_gmsh.h"
 #include "mesh/io/write_vtk.h"
+#include "mesh/patches/outlet_extension.h"
 #include "mesh/refine/subdivide.h"
 
 namespace naris {
@@ -196,9 +197,20 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
   const mve::VolumeField field = make_field(volume, job, r);
   mve::MveOptions options;
   options.keep_largest_component = job.keep_largest;
-  const PreparedCuts prepared = prepare_cuts(field, cuts, options);
-  r.mesh = mve::march_volume_elements(field, options, &r.mve);
-  finish_patches(r.mesh, field, cuts, prepared, regions, options.wall_patch);
+  PreparedCuts prepared = prepare_cuts(field, cuts, options);
+  std::optional<OutletExtension> extended;
+  if (job.outlet_extension > 0.0) {
+    extended.emplace(field, cuts, options, job.outlet_extension);
+    cuts = extended->cuts();
+    options = mve::MveOptions{.keep_largest_component = job.keep_largest};
+    prepared = prepare_cuts(*extended, cuts, options);
+    r.extension = {
+        .axis = extended->axis(), .voxels = extended->voxels(), .length_mm = extended->length_mm()};
+  }
+  const mve::FieldSource& source =
+      extended ? static_cast<const mve::FieldSource&>(*extended) : field;
+  r.mesh = mve::march_volume_elements(source, options, &r.mve);
+  finish_patches(r.mesh, source, cuts, prepared, regions, options.wall_patch);
   r.seconds.push_back({"mve", clock.seconds()});
 
   // The quality measured before and after improvement counts as one stage, improvement as another.
@@ -306,6 +318,7 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
         {"removed_cells", im.removed_cells},
         {"pyramids_to_tets", im.pyramids_to_tets}}},
       {"patches", patches},
+      {"outlet_extension_mm", significant(r.extension.length_mm)},
       {"quality_before", quality_json(r.before)},
       {"quality_after", quality_json(r.after)},
       {"seconds", seconds},
@@ -335,6 +348,16 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
       s += fmt::format("  perimeter {:.2f} mm  D_h = 4A/P = {:.3f} mm", p.perimeter,
                        p.hydraulic_diameter());
     s += "\n";
+  }
+  if (r.extension.axis >= 0) {
+    const auto outlet = std::find_if(r.patches.begin(), r.patches.end(),
+                                     [](const PatchReport& p) { return p.name == "outlet"; });
+    s += fmt::format(
+        "  extended  the outlet by {:.2f} mm ({} voxels along {}{})\n", r.extension.length_mm,
+        r.extension.voxels, static_cast<char>('i' + r.extension.axis),
+        outlet == r.patches.end() || outlet->hydraulic_diameter() <= 0.0
+            ? std::string()
+            : fmt::format(", {:.1f} D_h", r.extension.length_mm / outlet->hydraulic_diameter()));
   }
   auto line = [&](const char* label, const QualityReport& q) {
     const auto& all = q.summary[3];

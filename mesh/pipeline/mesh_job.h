@@ -28,6 +28,7 @@ struct MeshJob {
   double smooth = 0.0;
   std::optional<std::string> inlet, outlet;
   std::vector<std::string> regions;  // name:box=... or name:sphere=...
+  double outlet_extension = 0.0;     // mm of straight tube beyond the outlet (outlet_extension.h)
   bool keep_largest = true;
   bool improve = true;
   ImproveOptions improve_options;
@@ -47,6 +48,11 @@ struct MeshJobResult {
   std::vector<int> labels;              // a union of labels, meshed as one mask
   InsideRule rule = InsideRule::label;  // what inside meant
   mve::MveStats mve;
+  struct Extension {
+    int axis = -1;  // −1: none
+    int voxels = 0;
+    double length_mm = 0.0;
+  } extension;
   ImproveStats improvement;
   std::size_t cells_before_subdivision = 0;  // with subdivisions
   QualityReport before, after;
