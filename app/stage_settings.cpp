@@ -143,6 +143,17 @@ SolveSettings::SolveSettings() {
   table.add("inlet_expression", job.inlet_expression,
             "inlet profile as an expression of x, y, z and r (mm; r from the inlet's centroid), "
             "e.g. \"1-(r/1.5)^2\"; scaled to the mean inlet speed");
+  table
+      .add("backflow_smoothing", job.backflow_smoothing,
+           "width of the smoothing of the outlet's backflow switch (u·n)₋, in mean inlet speeds, "
+           "so that Newton's derivative is continuous where the flow through the outlet turns "
+           "(0: the exact switch)")
+      .non_negative();
+  table
+      .add("stability", job.stability_modes,
+           "after the solve, the N eigenvalues λ of the steady flow's linearization nearest zero "
+           "(J v = λ M v, SLEPc): a perturbation grows where Re λ < 0 (0: none)")
+      .non_negative();
   table.add("nu", job.viscosity, "kinematic viscosity (m²/s)");
   table.add("rho", job.density, "density (kg/m³)");
   table.add("re_start", job.start_reynolds, "first Reynolds number of the continuation");

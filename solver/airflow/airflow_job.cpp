@@ -196,6 +196,7 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
     problem.backflow.patches = {{m.outlet, 1.0}};
   else
     problem.backflow.patches = {{m.inlet, 0.5}};
+  problem.backflow.smoothing = job.backflow_smoothing;
   // What every solution file of the run carries besides its field and Re.
   SolutionState scales{.target_reynolds = r.reynolds,
                        .u_in = r.u_in,
@@ -203,6 +204,8 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
                        .density = job.density,
                        .viscosity = job.viscosity,
                        .mesh_fingerprint = m.fingerprint};
+  std::optional<ns::FlowProblem> stability_problem =
+      job.stability_modes > 0 ? std::optional(problem) : std::nullopt;
   PieceSolves solves(
       part.piece.mesh, part.piece.numbering, std::move(problem), m.inlet, m.outlet, job.drive,
       scales,
@@ -223,6 +226,14 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   }
   continuation.run();
   r.steps = continuation.steps();
+  if (stability_problem) {
+    Stopwatch clock;
+    stability_problem->reynolds = r.reynolds;  // run() reached the target or threw
+    r.modes = stability::leading_modes(part.piece.mesh, part.piece.numbering, *stability_problem,
+                                       continuation.solution(), {.modes = job.stability_modes});
+    log_line(fmt::format("  stability: {} eigenvalues nearest 0 at Re {:.2f} in {:.1f} s",
+                         r.modes.size(), stability_problem->reynolds, clock.seconds()));
+  }
   write_airflow_outputs(job, part, solves, continuation.solution(), m.openings, r);
   r.seconds = total.seconds();
   if (rank == 0) write_summary_json(job, r);

@@ -11,6 +11,7 @@
 
 #include "solver/continuation/reynolds_continuation.h"
 #include "solver/ns/boundary_conditions.h"
+#include "solver/stability/linear_stability.h"
 
 namespace naris::airflow {
 
@@ -35,6 +36,8 @@ struct AirflowJob {
   // the outlet with the inlet open to still air at ambient total pressure, so that its openings
   // (both nares) share the flow as the flow decides. Either way the flux is U_in × inlet area.
   ns::DrivenPatch drive = ns::DrivenPatch::inlet;
+  double backflow_smoothing = 0.0;  // of the natural patch's switch, in mean inlet speeds
+  int stability_modes = 0;  // eigenvalues of the steady flow's linearization (stability/), 0: none
   double start_reynolds = 50.0;  // the first continuation step
   int max_steps = 40;            // continuation steps, failed ones included
   double step_tolerance = 1e-5;  // of the steps before the target (reynolds_continuation.h)
@@ -77,6 +80,8 @@ struct AirflowResult {
   // |Σ patch forces + momentum carried out| over the largest wall force: how well the
   // consistent forces close the momentum balance.
   double momentum_balance = 0.0;
+  // The linearization's eigenvalues nearest zero at the answer, in U_in/d_in (linear_stability.h).
+  std::vector<stability::Mode> modes;
   std::vector<continuation::ContinuationStep> steps;
   std::size_t cells = 0, nodes = 0;
   double seconds = 0.0, restarted_from = 0.0;  // the checkpoint's Re, 0 without --restart

@@ -349,6 +349,14 @@ void write_summary_json(const AirflowJob& job, AirflowResult& r) {
            significant(o.centroid_mm[2])}},
          {"flow_ml_s", significant(o.flow_ml_s)},
          {"share", significant(r.inlet_flow_ml_s != 0.0 ? o.flow_ml_s / r.inlet_flow_ml_s : 0.0)}});
+  // A perturbation grows like exp(−λ t) (linear_stability.h); t in d_in/U_in.
+  Json modes = Json::array();
+  for (const auto& m : r.modes)
+    modes.push_back(
+        {{"eigenvalue_real", significant(m.eigenvalue.real())},
+         {"eigenvalue_imag", significant(m.eigenvalue.imag())},
+         {"growth_rate_per_s", significant(-m.eigenvalue.real() * r.u_in / (r.d_in_mm * 1e-3))},
+         {"relative_residual", significant(m.residual, 3)}});
   const Json summary = {
       {"mesh", job.mesh.string()},
       {"cells", r.cells},
@@ -376,6 +384,7 @@ void write_summary_json(const AirflowJob& job, AirflowResult& r) {
       {"max_speed_m_s", significant(r.max_speed)},
       {"patches", patches},
       {"momentum_balance", significant(r.momentum_balance, 3)},
+      {"stability", modes},
       {"continuation", steps},
       {"mpi_ranks", r.ranks},
       {"seconds", significant(r.seconds)},
@@ -405,6 +414,21 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
           r.inlet_flow_ml_s != 0.0 ? 100.0 * o.flow_ml_s / r.inlet_flow_ml_s : 0.0);
     }
   }
+  std::string stability;
+  if (!r.modes.empty()) {
+    std::vector<std::string> values;
+    bool stable = true;
+    for (const auto& m : r.modes) {
+      values.push_back(
+          m.eigenvalue.imag() == 0.0
+              ? fmt::format("{:.4g}", m.eigenvalue.real())
+              : fmt::format("{:.4g} {:+.4g}i", m.eigenvalue.real(), m.eigenvalue.imag()));
+      stable = stable && m.eigenvalue.real() > 0.0;
+    }
+    stability = fmt::format(
+        "\n  stability λ nearest 0 (U_in/d_in): {}; {}", fmt::join(values, ", "),
+        stable ? "none grows" : "a perturbation grows (Re λ < 0): the steady flow is unstable");
+  }
   const bool outlet_driven = job.drive == ns::DrivenPatch::outlet;
   return fmt::format(
       "naris solve: {} ({} cells, {} nodes)\n"
@@ -416,7 +440,7 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
       "  wall      shear stress mean {:.4f} Pa, max {:.4f} Pa; force {:.3e} N (surface "
       "integral {:.3e} N); momentum balance {:.1e}\n"
       "  solve     {} continuation steps, {} nonlinear steps, {:.1f} s, peak {} ({:.0f} bytes "
-      "per unknown)\n"
+      "per unknown){}\n"
       "  wrote     {}",
       job.mesh.filename().string(), r.cells, r.nodes, r.inlet_area_mm2, r.inlet_perimeter_mm,
       r.d_in_mm, profile_name(job), drive_name(job), r.reynolds, r.u_in, job.viscosity, job.density,
@@ -429,7 +453,7 @@ std::string format_airflow_summary(const AirflowJob& job, const AirflowResult& r
       r.ranks > 1 ? fmt::format("{:.0f} MB per rank, {:.0f} MB on {} ranks",
                                 megabytes(r.peak_memory), megabytes(r.total_peak_memory), r.ranks)
                   : fmt::format("{:.0f} MB", megabytes(r.peak_memory)),
-      bytes_per_unknown(r), fmt::join(r.written, "\n            "));
+      bytes_per_unknown(r), stability, fmt::join(r.written, "\n            "));
 }
 
 }  // namespace naris::airflow

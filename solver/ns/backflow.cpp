@@ -1,12 +1,10 @@
 #include "solver/ns/backflow.h"
 
-#include <algorithm>
-
 namespace naris::ns {
 
 void backflow_face(const HybridMesh& mesh, std::span<const NodeId> v,
-                   const std::vector<Eigen::Vector3d>& advection, double beta, Eigen::Matrix4d& M,
-                   Eigen::Matrix<double, 16, 16>* derivative) {
+                   const std::vector<Eigen::Vector3d>& advection, double beta, double smoothing,
+                   Eigen::Matrix4d& M, Eigen::Matrix<double, 16, 16>* derivative) {
   M.setZero();
   if (derivative) derivative->setZero();
   const int m = static_cast<int>(v.size());
@@ -24,15 +22,15 @@ void backflow_face(const HybridMesh& mesh, std::span<const NodeId> v,
       phi[q] = 0.0;
       Eigen::Vector3d a = Eigen::Vector3d::Zero();
       for (int i = 0; i < 3; ++i) a += phi[i] * advection[node(tri[i])];
-      const double inflow = std::min(0.0, a.dot(normal));
-      if (inflow == 0.0) continue;
+      const NegativePart inflow = negative_part(a.dot(normal), smoothing);
+      if (inflow.value == 0.0 && inflow.slope == 0.0) continue;
       const double weight = -beta * area / 3.0;
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) {
-          M(tri[i], tri[j]) += weight * inflow * phi[i] * phi[j];
+          M(tri[i], tri[j]) += weight * inflow.value * phi[i] * phi[j];
           if (derivative)
             derivative->block<3, 3>(4 * tri[i], 4 * tri[j]) +=
-                weight * phi[i] * phi[j] * a * normal.transpose();
+                weight * inflow.slope * phi[i] * phi[j] * a * normal.transpose();
         }
     }
   }

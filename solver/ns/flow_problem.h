@@ -19,6 +19,8 @@ struct BackflowStabilization {
     double beta = 1.0;
   };
   std::vector<Patch> patches;
+  // Width of the switch's smoothing (negative_part), in units of the mean inlet speed; 0: none.
+  double smoothing = 0.0;
   // β on `patch`, 0 where the term is not applied.
   double beta(int patch) const {
     for (const Patch& p : patches)

@@ -109,6 +109,15 @@ void OseenSystem::recover_gradient(const std::vector<Eigen::Vector3d>& a) {
   ns::recover_gradient(mesh_, a, gradient_, lumped_mass_);
 }
 
+void OseenSystem::velocity_mass(Vec v) const {
+  petsc::check(VecSet(v, 0.0), "VecSet");
+  PetscScalar* d = nullptr;
+  petsc::check(VecGetArray(v, &d), "VecGetArray");
+  for (std::size_t i = 0; i < static_cast<std::size_t>(numbering_.owned); ++i)
+    for (std::size_t c = 0; c < 3; ++c) d[4 * i + c] = lumped_mass_[i];
+  petsc::check(VecRestoreArray(v, &d), "VecRestoreArray");
+}
+
 void OseenSystem::add_pseudo_time(const std::vector<Eigen::Vector3d>& advection, double nu,
                                   double cfl) {
   PetscScalar* d = nullptr;
@@ -161,10 +170,10 @@ void OseenSystem::assemble_backflow(const std::vector<Eigen::Vector3d>& advectio
       return static_cast<std::size_t>(v[static_cast<std::size_t>(i)]);
     };
     Eigen::Matrix4d M;
-    // Newton's share, d/du of the term with a = u: −β ∫ H(−u·n) (δu·n) (u·w); rows and
+    // Newton's share, d/du of the term with a = u: −β ∫ (u·n)₋' (δu·n) (u·w); rows and
     // columns (4i + c) like PETSc's block.
     Eigen::Matrix<double, 16, 16> D;
-    backflow_face(mesh_, v, advection, beta, M, newton ? &D : nullptr);
+    backflow_face(mesh_, v, advection, beta, backflow_.smoothing, M, newton ? &D : nullptr);
     if (M.isZero()) return;
     // PETSc reads the (4m)×(4m) block row-major: velocity components on the block diagonal.
     std::array<double, 16 * 16> block{};

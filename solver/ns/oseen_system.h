@@ -56,6 +56,10 @@ class OseenSystem {
   // The lumped L2 projection of ∇a onto the nodes: G_i = Σ_K ∫ N_i ∇a / Σ_K ∫ N_i.
   void recover_gradient(const std::vector<Eigen::Vector3d>& a);
 
+  // The velocity rows' lumped mass ∫ N_i (of the last recover_gradient) into v's rows of this
+  // rank, 0 in the pressure rows.
+  void velocity_mass(Vec v) const;
+
   // Pseudo-transient continuation (Kelley & Keyes 1998): adds M/Δτ to the velocity rows of the
   // matrix — not to the residual, so the converged answer is the steady one. Δτ is local,
   // CFL · h / (|a| + ν/h) with h = (∫N_i)^⅓, so every node advances at the same Courant number.

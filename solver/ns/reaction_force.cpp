@@ -142,7 +142,7 @@ Reactions reaction_forces(const HybridMesh& piece, const parallel::NodeNumbering
     for_each_boundary_face(piece, [&](std::span<const NodeId> v, int patch) {
       const double beta = problem.backflow.beta(patch);
       if (beta == 0.0) return;
-      backflow_face(piece, v, field.velocity, beta, M, nullptr);
+      backflow_face(piece, v, field.velocity, beta, problem.backflow.smoothing, M, nullptr);
       for (std::size_t i = 0; i < v.size(); ++i) {
         Eigen::Vector3d b = Eigen::Vector3d::Zero();
         for (std::size_t j = 0; j < v.size(); ++j)
