@@ -195,14 +195,14 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
 
   clock = Stopwatch();
   const mve::VolumeField field = make_field(volume, job, r);
-  mve::MveOptions options;
-  options.keep_largest_component = job.keep_largest;
+  const mve::MveOptions initial{.keep_largest_component = job.keep_largest};
+  mve::MveOptions options = initial;
   PreparedCuts prepared = prepare_cuts(field, cuts, options);
   std::optional<OutletExtension> extended;
   if (job.outlet_extension > 0.0) {
     extended.emplace(field, cuts, options, job.outlet_extension);
     cuts = extended->cuts();
-    options = mve::MveOptions{.keep_largest_component = job.keep_largest};
+    options = initial;
     prepared = prepare_cuts(*extended, cuts, options);
     r.extension = {
         .axis = extended->axis(), .voxels = extended->voxels(), .length_mm = extended->length_mm()};

@@ -204,8 +204,6 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
                        .density = job.density,
                        .viscosity = job.viscosity,
                        .mesh_fingerprint = m.fingerprint};
-  std::optional<ns::FlowProblem> stability_problem =
-      job.stability_modes > 0 ? std::optional(problem) : std::nullopt;
   PieceSolves solves(
       part.piece.mesh, part.piece.numbering, std::move(problem), m.inlet, m.outlet, job.drive,
       scales,
@@ -226,13 +224,12 @@ AirflowResult run_airflow_job(const AirflowJob& job) {
   }
   continuation.run();
   r.steps = continuation.steps();
-  if (stability_problem) {
+  if (job.stability_modes > 0) {
     Stopwatch clock;
-    stability_problem->reynolds = r.reynolds;  // run() reached the target or threw
-    r.modes = stability::leading_modes(part.piece.mesh, part.piece.numbering, *stability_problem,
-                                       continuation.solution(), {.modes = job.stability_modes});
+    // run() reached the target or threw.
+    r.modes = solves.leading_modes(continuation.solution(), r.reynolds, job.stability_modes);
     log_line(fmt::format("  stability: {} eigenvalues nearest 0 at Re {:.2f} in {:.1f} s",
-                         r.modes.size(), stability_problem->reynolds, clock.seconds()));
+                         r.modes.size(), r.reynolds, clock.seconds()));
   }
   write_airflow_outputs(job, part, solves, continuation.solution(), m.openings, r);
   r.seconds = total.seconds();

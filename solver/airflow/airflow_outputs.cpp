@@ -355,7 +355,7 @@ void write_summary_json(const AirflowJob& job, AirflowResult& r) {
     modes.push_back(
         {{"eigenvalue_real", significant(m.eigenvalue.real())},
          {"eigenvalue_imag", significant(m.eigenvalue.imag())},
-         {"growth_rate_per_s", significant(-m.eigenvalue.real() * r.u_in / (r.d_in_mm * 1e-3))},
+         {"growth_rate_per_s", significant(-m.eigenvalue.real() * r.u_in / (r.d_in_mm * kMm))},
          {"relative_residual", significant(m.residual, 3)}});
   const Json summary = {
       {"mesh", job.mesh.string()},

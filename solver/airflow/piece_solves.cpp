@@ -126,6 +126,13 @@ ns::Reactions PieceSolves::reaction_forces(const ns::FlowField& f, double reynol
                              ns::airflow_patch_kinds(piece_, driven_), PETSC_COMM_WORLD);
 }
 
+std::vector<stability::Mode> PieceSolves::leading_modes(const ns::FlowField& f, double reynolds,
+                                                        int modes) const {
+  ns::FlowProblem problem = problem_;
+  problem.reynolds = reynolds;
+  return stability::leading_modes(piece_, numbering_, problem, f, {.modes = modes});
+}
+
 Eigen::Vector3d PieceSolves::momentum_outflow(const ns::FlowField& f) const {
   Eigen::Vector3d flux = ns::patch_momentum_flux(piece_, f.velocity, inlet_) +
                          ns::patch_momentum_flux(piece_, f.velocity, outlet_);

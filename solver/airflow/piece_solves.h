@@ -11,6 +11,7 @@
 #include "solver/ns/flow_problem.h"
 #include "solver/ns/reaction_force.h"
 #include "solver/parallel/partition.h"
+#include "solver/stability/linear_stability.h"
 
 namespace naris::airflow {
 
@@ -53,6 +54,9 @@ class PieceSolves final : public continuation::SteadySolves {
   // outlet; nondimensional, collective.
   ns::Reactions reaction_forces(const ns::FlowField& f, double reynolds) const;
   Eigen::Vector3d momentum_outflow(const ns::FlowField& f) const;
+  // The linearization's `modes` eigenvalues nearest zero at `reynolds` (stability/). Collective.
+  std::vector<stability::Mode> leading_modes(const ns::FlowField& f, double reynolds,
+                                             int modes) const;
   // The state at `reynolds` on the first rank (the others get an empty field). Collective.
   SolutionState state_at(const ns::FlowField& field, double reynolds) const;
   bool writer() const { return rank_ == 0; }

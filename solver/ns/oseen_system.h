@@ -56,7 +56,7 @@ class OseenSystem {
   // The lumped L2 projection of ∇a onto the nodes: G_i = Σ_K ∫ N_i ∇a / Σ_K ∫ N_i.
   void recover_gradient(const std::vector<Eigen::Vector3d>& a);
 
-  // The velocity rows' lumped mass ∫ N_i (of the last recover_gradient) into v's rows of this
+  // The velocity rows' lumped mass ∫ N_i (computed by every assembly) into v's rows of this
   // rank, 0 in the pressure rows.
   void velocity_mass(Vec v) const;
 

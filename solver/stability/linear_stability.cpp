@@ -68,7 +68,6 @@ std::vector<Mode> leading_modes(const HybridMesh& piece, const parallel::NodeNum
 
   // M: the velocity's lumped mass, nothing on the pressure and the fixed rows (their
   // eigenvalues are infinite and never near zero).
-  system.recover_gradient(field.velocity);
   petsc::Vector mass;
   check(VecDuplicate(system.solution(), mass.out()), "VecDuplicate");
   system.velocity_mass(mass);

@@ -197,7 +197,6 @@ TEST(LinearStability, EigenvaluesNearestZeroMatchTheDenseGeneralizedProblem) {
     const std::vector<double> c = values(column);
     for (Eigen::Index i = 0; i < size; ++i) J(i, j) = c[static_cast<std::size_t>(i)];
   }
-  system.recover_gradient(x.velocity);
   petsc::Vector mass;
   petsc::check(VecDuplicate(system.solution(), mass.out()), "VecDuplicate");
   system.velocity_mass(mass);
