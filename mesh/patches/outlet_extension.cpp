@@ -69,14 +69,14 @@ void OutletExtension::read_slice(int k, std::span<float> out) const {
     return;
   }
   const auto& d = base_.frame().dims;
-  std::vector<float> slice(static_cast<std::size_t>(d[0]) * d[1]);
-  base_.read_slice(k, slice);
+  slice_.resize(static_cast<std::size_t>(d[0]) * d[1]);
+  base_.read_slice(k, slice_);
   const int ni = frame_.dims[0], nj = frame_.dims[1];
   for (int j = 0; j < nj; ++j)
     for (int i = 0; i < ni; ++i) {
       const int si = axis_ == 0 ? source_index(i) : i;
       const int sj = axis_ == 1 ? source_index(j) : j;
-      out[static_cast<std::size_t>(j) * ni + i] = slice[static_cast<std::size_t>(sj) * d[0] + si];
+      out[static_cast<std::size_t>(j) * ni + i] = slice_[static_cast<std::size_t>(sj) * d[0] + si];
     }
 }
 

@@ -82,20 +82,14 @@ class NavierStokesSolver {
  private:
   enum class Next { go_on, stop };
 
-  // The Dirichlet data into the iterate, and the fixed rows of this rank: three per velocity
-  // node, one for the pinned pressure.
+  // The Dirichlet data into the iterate, and the rows of this rank they fix.
   void fix_boundary_values() {
     const ns::DirichletConditions& bc = problem_.conditions;
-    for (std::size_t k = 0; k < bc.nodes.size(); ++k) {
+    for (std::size_t k = 0; k < bc.nodes.size(); ++k)
       field_.velocity[static_cast<std::size_t>(bc.nodes[k])] = bc.values[k];
-      if (system_.owns(bc.nodes[k]))
-        for (int c = 0; c < 3; ++c) rows_.push_back(4 * system_.block(bc.nodes[k]) + c);
-    }
-    if (bc.pressure_pin) {
+    if (bc.pressure_pin)
       field_.pressure[static_cast<std::size_t>(bc.pressure_pin->first)] = bc.pressure_pin->second;
-      if (system_.owns(bc.pressure_pin->first))
-        rows_.push_back(4 * system_.block(bc.pressure_pin->first) + 3);
-    }
+    rows_ = system_.fixed_rows(bc);
     zeros_.assign(rows_.size(), 0.0);
   }
 

@@ -54,6 +54,16 @@ OseenSystem::OseenSystem(const HybridMesh& mesh, const parallel::NodeNumbering& 
   insertion_.emplace(matrix_, numbering_);
 }
 
+std::vector<PetscInt> OseenSystem::fixed_rows(const DirichletConditions& bc) const {
+  std::vector<PetscInt> rows;
+  for (const NodeId node : bc.nodes)
+    if (owns(node))
+      for (int c = 0; c < 3; ++c) rows.push_back(4 * block(node) + c);
+  if (bc.pressure_pin && owns(bc.pressure_pin->first))
+    rows.push_back(4 * block(bc.pressure_pin->first) + 3);
+  return rows;
+}
+
 void OseenSystem::gather(Vec v, FlowField& field) {
   petsc::check(VecScatterBegin(gather_, v, piece_, INSERT_VALUES, SCATTER_FORWARD),
                "VecScatterBegin");

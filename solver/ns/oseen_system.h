@@ -34,6 +34,8 @@ class OseenSystem {
   bool owns(NodeId node) const { return numbering_.owns(node); }
   PetscInt block(NodeId node) const { return numbering_.to_global(node); }
   int rank() const { return rank_; }
+  // The global rows of this rank that `bc` fixes: three per velocity node, the pinned pressure.
+  std::vector<PetscInt> fixed_rows(const DirichletConditions& bc) const;
 
   // v's values at every node of the piece.
   void gather(Vec v, FlowField& field);

@@ -36,17 +36,6 @@ class SlepcSession {
 
 using Eigensolver = petsc::Handle<EPS, EPSDestroy>;
 
-// The rows this rank fixes by Dirichlet conditions: three per velocity node, the pinned pressure.
-std::vector<PetscInt> fixed_rows(const ns::OseenSystem& system, const ns::DirichletConditions& bc) {
-  std::vector<PetscInt> rows;
-  for (const NodeId node : bc.nodes)
-    if (system.owns(node))
-      for (int c = 0; c < 3; ++c) rows.push_back(4 * system.block(node) + c);
-  if (bc.pressure_pin && system.owns(bc.pressure_pin->first))
-    rows.push_back(4 * system.block(bc.pressure_pin->first) + 3);
-  return rows;
-}
-
 }  // namespace
 
 std::vector<Mode> leading_modes(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
@@ -57,7 +46,7 @@ std::vector<Mode> leading_modes(const HybridMesh& piece, const parallel::NodeNum
   const MPI_Comm comm =
       problem.communicator == MPI_COMM_NULL ? PETSC_COMM_WORLD : problem.communicator;
   ns::OseenSystem system(piece, numbering, comm, options.prefix, problem.backflow, MATBAIJ);
-  const std::vector<PetscInt> rows = fixed_rows(system, problem.conditions);
+  const std::vector<PetscInt> rows = system.fixed_rows(problem.conditions);
   system.use_newton_operator(rows);
   const double nu = 1.0 / problem.reynolds;
   system.assemble(field.velocity, field.pressure, nu, problem.force, ns::Linearization::newton);
@@ -132,6 +121,13 @@ std::vector<Mode> leading_modes(const HybridMesh& piece, const parallel::NodeNum
   std::sort(modes.begin(), modes.end(), [](const Mode& a, const Mode& b) {
     return std::abs(a.eigenvalue) < std::abs(b.eigenvalue);
   });
+  // SLEPc may converge more than asked; keep the nearest, with a complex pair kept whole.
+  std::size_t kept = std::min(modes.size(), static_cast<std::size_t>(options.modes));
+  if (kept > 0 && kept < modes.size() && modes[kept - 1].eigenvalue.imag() != 0.0 &&
+      std::abs(modes[kept].eigenvalue - std::conj(modes[kept - 1].eigenvalue)) <=
+          1e-8 * std::abs(modes[kept].eigenvalue))
+    ++kept;
+  modes.resize(kept);
   return modes;
 }
 

@@ -26,8 +26,9 @@ struct Mode {
   double residual = 0.0;            // ‖J v − λ M v‖ / ‖λ M v‖ as SLEPc reports it
 };
 
-// The steady `field` on this rank's piece (parallel/partition.h), of `problem`; the modes
-// sorted by |λ|, nearest zero first. Collective over the problem's communicator.
+// The steady `field` on this rank's piece (parallel/partition.h), of `problem`; the
+// `options.modes` nearest zero (one more where the last is half of a complex pair; fewer if
+// SLEPc converged fewer), sorted by |λ|. Collective over the problem's communicator.
 std::vector<Mode> leading_modes(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
                                 const ns::FlowProblem& problem, const ns::FlowField& field,
                                 const StabilityOptions& options = {});

@@ -10,6 +10,7 @@
 #include <vtkXMLUnstructuredGridReader.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -732,6 +733,56 @@ TEST_F(Cli, RestartTakesTheUninterruptedPath) {
     fs::remove_all(whole);
     fs::remove_all(stopped);
     fs::remove_all(resumed);
+  }
+}
+
+// naris solve --stability N: at Re 20 the flow is nearly Stokes flow, whose perturbations all
+// decay (Re λ > 0 for every eigenvalue); the modes reach summary.json and the log, and two
+// ranks find the same eigenvalues as one.
+TEST_F(Cli, StabilityOfASlowFlowFindsOnlyDecayingModesOnOneAndTwoRanks) {
+  const fs::path mesh = dir_ / "in" / "mesh.h5";
+  ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
+  const fs::path one = dir_ / "one", two = dir_ / "two";
+  const std::string solve = "solve " + mesh.string() + " --re 20 --tolerance 1e-10 --stability 3";
+  CliRun r = naris(solve + " -o " + one.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("eigenvalues nearest 0 at Re 20.00"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("none grows"), std::string::npos) << r.err;
+  r = naris(solve + " -o " + two.string(),
+            "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 " +
+                std::string(NARIS_MPIEXEC) + " -n 2 --oversubscribe ");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto modes = [](const fs::path& folder) {
+    std::ifstream file(folder / "summary.json");
+    const nlohmann::json j = nlohmann::json::parse(file);
+    std::vector<std::array<double, 3>> out;  // Re λ, Im λ, growth rate
+    for (const auto& m : j.at("stability"))
+      out.push_back({m.at("eigenvalue_real").get<double>(), m.at("eigenvalue_imag").get<double>(),
+                     m.at("growth_rate_per_s").get<double>()});
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  const auto a = modes(one), b = modes(two);
+  // Three, or four where the third is half of a complex pair: a pair is never split.
+  ASSERT_GE(a.size(), 3u);
+  ASSERT_LE(a.size(), 4u);
+  ASSERT_EQ(b.size(), a.size());
+  for (const auto& m : a)
+    EXPECT_EQ(std::count_if(a.begin(), a.end(),
+                            [&](const auto& o) {
+                              return std::abs(o[0] - m[0]) <= 1e-5 * std::abs(m[0]) &&
+                                     std::abs(o[1] + m[1]) <= 1e-5 * std::abs(m[0]);
+                            }),
+              1)
+        << "the conjugate of " << m[0] << " " << m[1];
+  const double u_in = summary(one, "inlet_speed_m_s"),
+               d_in = summary(one, "inlet_hydraulic_diameter_mm") * 1e-3;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_GT(a[k][0], 0.0) << k;
+    // The growth rate is −Re λ in the solver's time unit d_in / U_in.
+    EXPECT_NEAR(a[k][2], -a[k][0] * u_in / d_in, 1e-5 * std::abs(a[k][2])) << k;
+    EXPECT_NEAR(b[k][0], a[k][0], 1e-5 * std::abs(a[k][0])) << k;
+    EXPECT_NEAR(b[k][1], a[k][1], 1e-5 * std::abs(a[k][0])) << k;
   }
 }
 
