@@ -1,6 +1,7 @@
 #pragma once
-// Analytic flows for the tracker tests: uniform flow in unbounded space, and Hagen–Poiseuille
-// flow in a pipe along z from 0 (inlet) to its length (outlet), the wall at radius R.
+// Analytic flows for the tracker tests: uniform flow and solid-body rotation in unbounded space,
+// and Hagen–Poiseuille flow in a pipe along z from 0 (inlet) to its length (outlet), the wall at
+// radius R.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -23,6 +24,23 @@ class UniformFlow : public particles::FlowDomain {
 
  private:
   Vec3 u_;
+  std::vector<std::string> names_;
+};
+
+// u = Ω ẑ × x: the air turns about the z axis at Ω; `cell` is the length a step resolves.
+class SolidBodyRotation : public particles::FlowDomain {
+ public:
+  SolidBodyRotation(double omega, double cell) : omega_(omega), cell_(cell) {}
+  Vec3 velocity(const Vec3&, int&, const Vec3& x) const override {
+    return {-omega_ * x[1], omega_ * x[0], 0.0};
+  }
+  Passage pass(const Vec3&, const Vec3&, int&, double) const override { return {}; }
+  double cell_size(int) const override { return cell_; }
+  int locate(const Vec3&) const override { return 0; }
+  const std::vector<std::string>& patch_names() const override { return names_; }
+
+ private:
+  double omega_, cell_;
   std::vector<std::string> names_;
 };
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
 #include <cstdio>
 
 #include "solver/particles/tracker.h"
@@ -62,6 +63,40 @@ TEST(Particles, SettleAtTheTerminalSpeedInStillAir) {
   const double re = o.air.density * v * kind.diameter / o.air.viscosity;
   EXPECT_LT(v, terminal);
   EXPECT_NEAR(drag_factor(DragLaw::schiller_naumann, re) * v, terminal, 1e-6 * terminal);
+}
+
+// The centrifugal drift that deposits particles in a bend: in air turning at Ω, a particle
+// with Stokes drag obeys τ z'' + z' = iΩ z (z = x + iy), so z = A e^(s₁t) + B e^(s₂t) with
+// τ s² + s − iΩ = 0; released with the air's velocity it spirals out at Re s₁ ≈ τΩ². Three
+// turns at Ωτ = 0.05 (the radius grows by e^(3·2π·0.05) ≈ 2.5) with the default step control
+// and a cell of a tenth of the start radius.
+TEST(Particles, InertialParticleSpiralsOutOfSolidBodyRotationAsTheClosedForm) {
+  const double r0 = 0.01, omega = 100.0;
+  const testing::SolidBodyRotation flow(omega, 0.1 * r0);
+  TraceOptions o;
+  o.drag = DragLaw::stokes;
+  o.path_spacing = 0.0;
+  const double d = 10e-6, tau = 0.05 / omega;
+  const ParticleKind kind{
+      d, 18.0 * o.air.viscosity * tau / (d * d * cunningham_factor(d, o.air.mean_free_path))};
+  ASSERT_NEAR(relaxation_time(kind, o.air), tau, 1e-12 * tau);
+  o.max_time = 3.0 * 2.0 * M_PI / omega;
+  const Vec3 x0(r0, 0.0, 0.0);
+  const ParticleResult r = track(flow, {x0, std::nullopt, 0}, kind, o, {}, false);
+  ASSERT_EQ(r.fate, Fate::max_time);
+  using C = std::complex<double>;
+  const C root = std::sqrt(C(1.0, 4.0 * omega * tau));
+  const C s1 = (-1.0 + root) / (2.0 * tau), s2 = (-1.0 - root) / (2.0 * tau);
+  const C z0(r0, 0.0), v0 = C(0.0, omega) * z0;
+  const C a = (v0 - s2 * z0) / (s1 - s2), b = z0 - a;
+  const C z = a * std::exp(s1 * r.time) + b * std::exp(s2 * r.time);
+  EXPECT_GT(std::abs(z), 2.0 * r0);  // the drift is what is tested
+  // The radius to 1e-4; the angle, an error accumulated over three turns, to 1e-3 rad.
+  EXPECT_NEAR(r.end.head<2>().norm(), std::abs(z), 1e-4 * std::abs(z));
+  EXPECT_NEAR(std::remainder(std::atan2(r.end[1], r.end[0]) - std::arg(z), 2.0 * M_PI), 0.0, 1e-3);
+  EXPECT_NEAR(r.end[2], 0.0, 1e-15);
+  std::printf("[ info ] r/r0 %.6f (closed form %.6f), %ld steps\n", r.end.head<2>().norm() / r0,
+              std::abs(z) / r0, r.steps);
 }
 
 TEST(Particles, TracersInPoiseuilleFlowKeepTheirRadiusAndTakeTheAnalyticTime) {
