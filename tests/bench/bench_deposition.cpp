@@ -2,12 +2,14 @@
 // §6): a tube of diameter D bent at R_b = 5.7 D/2, meshed by MVE from the sampled torus at
 // several resolutions, the steady laminar flow solved by naris at Re 1000 with a developed inlet
 // profile, flux-weighted particles, Stokes drag. Stk = ρ_p d² C_c Ū / (9 μ D) = τ Ū / (D/2).
-// Prints one row per resolution and Stokes number.
+// Prints one row per resolution and Stokes number. With --uniform-inlet the air enters the bend
+// with a flat profile instead (a bend fed by a short straight tube).
 //
-//   bench_deposition [particles = 10000] [cells across D ...= 14 20 28]
+//   bench_deposition [--uniform-inlet] [particles = 10000] [cells across D ...= 14 20 28]
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "core/log.h"
@@ -25,9 +27,12 @@ using namespace naris::particles;
 int main(int argc, char** argv) {
   petsc::Session session;
   set_verbosity(Verbosity::quiet);
-  const int n = argc > 1 ? std::atoi(argv[1]) : 10000;
+  int first = 1;
+  const bool uniform = argc > 1 && std::string(argv[1]) == "--uniform-inlet";
+  if (uniform) ++first;
+  const int n = argc > first ? std::atoi(argv[first]) : 10000;
   std::vector<int> resolutions;
-  for (int i = 2; i < argc; ++i) resolutions.push_back(std::atoi(argv[i]));
+  for (int i = first + 1; i < argc; ++i) resolutions.push_back(std::atoi(argv[i]));
   if (resolutions.empty()) resolutions = {14, 20, 28};
   // Lengths in units of D (read as millimetres), the velocity in units of Ū (read as m/s).
   const double a = 0.5, bend = 2.85, re = 1000.0;
@@ -43,7 +48,8 @@ int main(int argc, char** argv) {
     const HybridMesh m =
         testing::mve_mesh_box([&](const Vec3& x) { return a - s(x); }, {0.0, 0.0, -0.6},
                               {3.5, 3.5, 0.6}, 1.0 / across, options);
-    const ns::DirichletConditions bc = ns::airflow_conditions(m, ns::InletProfile::developed, 1.0);
+    const ns::DirichletConditions bc = ns::airflow_conditions(
+        m, uniform ? ns::InletProfile::uniform : ns::InletProfile::developed, 1.0);
     ns::FlowField field;
     for (double step : {100.0, 300.0, 600.0, re}) {
       nonlinear::NonlinearReport report;
