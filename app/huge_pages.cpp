@@ -2,6 +2,8 @@
 // kernel's fault per 4 KiB page was a third of `naris mesh` on a 4 M-cell mesh, in the arrays
 // its improvement, quality and check stages fill once (docs/results/mesh-speed.md); the kernel
 // leaves huge pages to regions advised so (THP "madvise" mode, Debian's default).
+// Left out under AddressSanitizer, whose own operator new checks new/delete pairs.
+#ifndef __SANITIZE_ADDRESS__
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -46,3 +48,4 @@ void operator delete(void* p, std::size_t) noexcept {
 void operator delete[](void* p, std::size_t) noexcept {
   std::free(p);
 }
+#endif

@@ -16,7 +16,7 @@
 namespace naris::mve {
 
 // A scalar field sampled on a grid; inside where the value is > 0. Slices are along the third
-// index (k), each nx·ny values with i fastest.
+// index (k), each nx·ny values with i fastest, read by one thread at a time.
 class FieldSource {
  public:
   virtual ~FieldSource() = default;

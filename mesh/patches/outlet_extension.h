@@ -41,7 +41,7 @@ class OutletExtension : public mve::FieldSource {
   int voxels_ = 0;
   int shift_ = 0;             // index here − index in the base image, along the axis
   int first_ = 0, last_ = 0;  // the base's voxel planes kept along the axis
-  // The base slice being reordered along i or j (readers take slices one at a time).
+  // The base slice being reordered along i or j (FieldSource: one reader at a time).
   mutable std::vector<float> slice_;
 };
 

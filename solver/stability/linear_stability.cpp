@@ -121,13 +121,16 @@ std::vector<Mode> leading_modes(const HybridMesh& piece, const parallel::NodeNum
   std::sort(modes.begin(), modes.end(), [](const Mode& a, const Mode& b) {
     return std::abs(a.eigenvalue) < std::abs(b.eigenvalue);
   });
-  // SLEPc may converge more than asked; keep the nearest, with a complex pair kept whole.
+  // SLEPc may converge more than asked; keep the nearest, with a complex pair kept whole, and
+  // every growing one (a perturbation that grows is never dropped).
   std::size_t kept = std::min(modes.size(), static_cast<std::size_t>(options.modes));
   if (kept > 0 && kept < modes.size() && modes[kept - 1].eigenvalue.imag() != 0.0 &&
       std::abs(modes[kept].eigenvalue - std::conj(modes[kept - 1].eigenvalue)) <=
           1e-8 * std::abs(modes[kept].eigenvalue))
     ++kept;
-  modes.resize(kept);
+  modes.erase(std::remove_if(modes.begin() + static_cast<std::ptrdiff_t>(kept), modes.end(),
+                             [](const Mode& mode) { return mode.eigenvalue.real() >= 0.0; }),
+              modes.end());
   return modes;
 }
 

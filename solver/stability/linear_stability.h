@@ -28,7 +28,8 @@ struct Mode {
 
 // The steady `field` on this rank's piece (parallel/partition.h), of `problem`; the
 // `options.modes` nearest zero (one more where the last is half of a complex pair; fewer if
-// SLEPc converged fewer), sorted by |λ|. Collective over the problem's communicator.
+// SLEPc converged fewer), then any other converged mode that grows (Re λ < 0), sorted by |λ|.
+// Collective over the problem's communicator.
 std::vector<Mode> leading_modes(const HybridMesh& piece, const parallel::NodeNumbering& numbering,
                                 const ns::FlowProblem& problem, const ns::FlowField& field,
                                 const StabilityOptions& options = {});
