@@ -152,7 +152,8 @@ SolveSettings::SolveSettings() {
   table
       .add("stability", job.stability_modes,
            "after the solve, the N eigenvalues λ of the steady flow's linearization nearest zero "
-           "(J v = λ M v, SLEPc): a perturbation grows where Re λ < 0 (0: none)")
+           "(J v = λ M v, SLEPc; one more to keep a complex pair whole, and any other growing "
+           "one found): a perturbation grows where Re λ < 0 (0: none)")
       .non_negative();
   table.add("nu", job.viscosity, "kinematic viscosity (m²/s)");
   table.add("rho", job.density, "density (kg/m³)");

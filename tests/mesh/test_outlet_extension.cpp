@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "mesh/patches/outlet_extension.h"
+#include "mesh/patches/section_planes.h"
 #include "mesh/quality/check.h"
 #include "tests/mesh/field_helpers.h"
 
@@ -42,22 +43,13 @@ ArrayField tapered_pipe(int axis) {
 
 struct Patch {
   double area = 0.0;
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // of the faces' nodes, area-weighted
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // area-weighted
 };
 
 Patch patch(const HybridMesh& m, const std::string& name) {
-  const int id = m.patch_id(name);
-  Patch p;
-  for_each_boundary_face(m, [&](std::span<const NodeId> v, std::int32_t patch_of) {
-    if (patch_of != id) return;
-    for (std::size_t t = 1; t + 1 < v.size(); ++t) {
-      const Eigen::Vector3d &a = m.nodes[v[0]], &b = m.nodes[v[t]], &c = m.nodes[v[t + 1]];
-      const double area = 0.5 * (b - a).cross(c - a).norm();
-      p.area += area;
-      p.centroid += area * (a + b + c) / 3.0;
-    }
-  });
-  p.centroid /= p.area;
+  Patch p{.centroid = patch_centroid(m, m.patch_id(name))};
+  for (const PatchReport& r : patch_report(m))
+    if (r.name == name) p.area = r.area;
   return p;
 }
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "solver/ns/backflow.h"
+#include "solver/ns/boundary_conditions.h"
 #include "solver/ns/oseen_system.h"
 #include "solver/parallel/partition.h"
 #include "solver/parallel/petsc.h"
@@ -157,15 +158,7 @@ TEST(LinearStability, EigenvaluesNearestZeroMatchTheDenseGeneralizedProblem) {
   problem.reynolds = 200.0;
   problem.backflow = {{{mesh.patch_id("outlet"), 1.0}}, 0.1};
   // The pipe's inlet and wall fixed (their values do not enter J), the outlet free.
-  for_each_boundary_face(mesh, [&](std::span<const NodeId> v, std::int32_t patch) {
-    if (patch == mesh.patch_id("outlet")) return;
-    for (NodeId k : v) problem.conditions.nodes.push_back(k);
-  });
-  std::sort(problem.conditions.nodes.begin(), problem.conditions.nodes.end());
-  problem.conditions.nodes.erase(
-      std::unique(problem.conditions.nodes.begin(), problem.conditions.nodes.end()),
-      problem.conditions.nodes.end());
-  problem.conditions.values.assign(problem.conditions.nodes.size(), Vec3::Zero());
+  problem.conditions = airflow_conditions(mesh, InletProfile::uniform, 1.0);
   const FlowField x = state(mesh);
   const std::vector<stability::Mode> modes =
       stability::leading_modes(mesh, numbering, problem, x, {.modes = 4, .tolerance = 1e-10});
