@@ -102,6 +102,9 @@ MeshSettings::MeshSettings() {
       .add("min_edge", job.improve_options.min_edge_fraction,
            "improvement: collapse edges shorter than this fraction of the voxel size")
       .range(0.0, 0.5);
+  table.add("relocate", job.relocate,
+            "after the collapses, move the nodes of cells below the quality targets (wall nodes "
+            "sliding on the surface) and remove wall slivers");
   table
       .add("subdivide", job.subdivisions,
            "refine N times after the improvement, each time every cell into 8 of half its size "

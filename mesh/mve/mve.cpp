@@ -12,7 +12,59 @@
 namespace naris::mve {
 
 VolumeField::VolumeField(const Volume<float>& volume, InsideRule rule, double level)
-    : volume_(volume), rule_(rule), level_(static_cast<float>(level)) {}
+    : volume_(volume),
+      rule_(rule),
+      level_(static_cast<float>(level)),
+      to_index_(volume.frame.index_to_physical().inverse()) {}
+
+float VolumeField::value(std::size_t voxel) const {
+  const float v = volume_.values[voxel];
+  switch (rule_) {
+    case InsideRule::above:
+      return v - level_;
+    case InsideRule::below:
+      return level_ - v;
+    case InsideRule::label:
+      break;
+  }
+  return v == level_ ? 1.0f : -1.0f;
+}
+
+bool VolumeField::evaluate(const Eigen::Vector3d& x, double& value_at,
+                           Eigen::Vector3d& gradient) const {
+  const auto& dims = volume_.frame.dims;
+  const Eigen::Vector3d c = to_index_ * (x - volume_.frame.origin);
+  std::array<int, 3> lo;
+  Eigen::Vector3d t;
+  for (int a = 0; a < 3; ++a) {
+    if (dims[a] < 2 || !(c[a] >= 0.0 && c[a] <= dims[a] - 1)) return false;
+    lo[a] = std::min(static_cast<int>(c[a]), dims[a] - 2);
+    t[a] = c[a] - lo[a];
+  }
+  double f[2][2][2];
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i)
+        f[k][j][i] = value(volume_.frame.index(lo[0] + i, lo[1] + j, lo[2] + k));
+  // Along i, then j, then k; the derivatives of each stage alongside.
+  double fj[2][2], dfj_di[2][2];
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j) {
+      fj[k][j] = f[k][j][0] + t[0] * (f[k][j][1] - f[k][j][0]);
+      dfj_di[k][j] = f[k][j][1] - f[k][j][0];
+    }
+  double fk[2], dfk_di[2], dfk_dj[2];
+  for (int k = 0; k < 2; ++k) {
+    fk[k] = fj[k][0] + t[1] * (fj[k][1] - fj[k][0]);
+    dfk_di[k] = dfj_di[k][0] + t[1] * (dfj_di[k][1] - dfj_di[k][0]);
+    dfk_dj[k] = fj[k][1] - fj[k][0];
+  }
+  value_at = fk[0] + t[2] * (fk[1] - fk[0]);
+  const Eigen::Vector3d d_index(dfk_di[0] + t[2] * (dfk_di[1] - dfk_di[0]),
+                                dfk_dj[0] + t[2] * (dfk_dj[1] - dfk_dj[0]), fk[1] - fk[0]);
+  gradient = to_index_.transpose() * d_index;
+  return true;
+}
 
 void VolumeField::read_slice(int k, std::span<float> out) const {
   const auto in = volume_.slice(k);

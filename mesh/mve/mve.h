@@ -12,6 +12,7 @@
 #include "mesh/hybrid_mesh.h"
 #include "mesh/image/inside_rule.h"
 #include "mesh/image/volume.h"
+#include "mesh/quality/level_set.h"
 
 namespace naris::mve {
 
@@ -66,18 +67,23 @@ HybridMesh march_volume_elements(const FieldSource& field, const MveOptions& opt
                                  MveStats* stats = nullptr);
 
 // A FieldSource over a volume in memory: inside by `rule` (below or above a threshold, or equal
-// to a label).
-class VolumeField : public FieldSource {
+// to a label). As a LevelSet it is the trilinear interpolant of the same values inside the
+// image: the surface on which MVE's isopoints lie (linear along the grid's edges).
+class VolumeField : public FieldSource, public LevelSet {
  public:
   VolumeField(const Volume<float>& volume, InsideRule rule, double level);
   const ImageFrame& frame() const override { return volume_.frame; }
   void read_slice(int k, std::span<float> out) const override;
   bool binary() const override { return rule_ == InsideRule::label; }
+  bool evaluate(const Eigen::Vector3d& x, double& value, Eigen::Vector3d& gradient) const override;
 
  private:
+  float value(std::size_t voxel) const;
+
   const Volume<float>& volume_;
   InsideRule rule_;
   float level_;
+  Eigen::Matrix3d to_index_;  // physical offset → continuous index
 };
 
 }  // namespace naris::mve

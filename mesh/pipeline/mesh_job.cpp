@@ -223,6 +223,19 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
     std::vector<std::int64_t> unchanged_from;
     r.improvement =
         improve_mesh(r.mesh, volume.frame.spacing.minCoeff(), job.improve_options, &unchanged_from);
+    // Wall nodes slide on the field's level zero; those of the cut planes and the box sides stay.
+    if (job.relocate) {
+      std::vector<bool> on_surface(r.mesh.patch_names.size(), true);
+      for (std::size_t p = 0; p < on_surface.size(); ++p) {
+        const std::string& name = r.mesh.patch_names[p];
+        on_surface[p] =
+            std::none_of(cuts.begin(), cuts.end(), [&](const Cut& c) { return c.patch == name; }) &&
+            std::find(options.side_patch.begin(), options.side_patch.end(), name) ==
+                options.side_patch.end();
+      }
+      r.relocation =
+          relocate_nodes(r.mesh, &field, on_surface, job.relocate_options, &unchanged_from);
+    }
     r.seconds.push_back({"improve", clock.seconds()});
     clock = Stopwatch();
     r.quality = cell_quality(r.mesh, r.quality, unchanged_from, job.threads);
@@ -317,6 +330,16 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
         {"refused_geometry", im.refused_geometry},
         {"removed_cells", im.removed_cells},
         {"pyramids_to_tets", im.pyramids_to_tets}}},
+      {"relocation",
+       {{"cells_below_target_before", r.relocation.cells_below_before},
+        {"cells_below_target_after", r.relocation.cells_below_after},
+        {"worst_score_before", significant(r.relocation.worst_before)},
+        {"worst_score_after", significant(r.relocation.worst_after)},
+        {"nodes_moved", r.relocation.nodes_moved},
+        {"moves", r.relocation.moves},
+        {"slivers_removed", r.relocation.slivers_removed},
+        {"largest_surface_offset_mm", significant(r.relocation.largest_surface_offset)},
+        {"seconds", significant(r.relocation.seconds, 5)}}},
       {"patches", patches},
       {"outlet_extension_mm", significant(r.extension.length_mm)},
       {"quality_before", quality_json(r.before)},
@@ -373,6 +396,12 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
         "pyramids → tets\n",
         r.improvement.collapsed, r.improvement.refused_topology + r.improvement.refused_geometry,
         r.improvement.removed_cells, r.improvement.pyramids_to_tets);
+  if (job.improve && job.relocate)
+    s += fmt::format(
+        "  relocated {} nodes, removed {} wall slivers: cells below target {} → {}, worst score "
+        "{:.3f} → {:.3f}\n",
+        r.relocation.nodes_moved, r.relocation.slivers_removed, r.relocation.cells_below_before,
+        r.relocation.cells_below_after, r.relocation.worst_before, r.relocation.worst_after);
   if (job.subdivisions > 0)
     s += fmt::format("  subdivided {}× (same geometry): {} → {} cells\n", job.subdivisions,
                      r.cells_before_subdivision, m.cell_count());

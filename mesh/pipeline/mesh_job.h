@@ -14,6 +14,7 @@
 #include "mesh/quality/check.h"
 #include "mesh/quality/improve.h"
 #include "mesh/quality/quality.h"
+#include "mesh/quality/relocate.h"
 
 namespace naris {
 
@@ -32,6 +33,10 @@ struct MeshJob {
   bool keep_largest = true;
   bool improve = true;
   ImproveOptions improve_options;
+  // Node relocation and wall-sliver removal after the collapses (relocate.h); off by default
+  // while it does not yet reach its targets.
+  bool relocate = false;
+  RelocateOptions relocate_options;
   // Uniform refinements after the improvement (refine/subdivide.h): each multiplies the cells
   // by 8 and keeps the geometry, for mesh-convergence studies on one anatomy.
   int subdivisions = 0;
@@ -54,6 +59,7 @@ struct MeshJobResult {
     double length_mm = 0.0;
   } extension;
   ImproveStats improvement;
+  RelocateStats relocation;
   std::size_t cells_before_subdivision = 0;  // with subdivisions
   QualityReport before, after;
   std::vector<CellQuality> quality;  // per cell of the final mesh, in its cell order

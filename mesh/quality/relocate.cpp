@@ -1,0 +1,557 @@
+#include "mesh/quality/relocate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <span>
+#include <unordered_map>
+
+#include "core/log.h"
+
+namespace naris {
+namespace {
+
+using Vec = Eigen::Vector3d;
+constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
+
+enum class Freedom : std::uint8_t { fixed, interior, surface };
+
+// The cells of the mesh in its order (tetrahedra, pyramids, hexahedra) as node spans.
+struct Cells {
+  const HybridMesh& mesh;
+  std::size_t count() const { return mesh.cell_count(); }
+  std::span<const NodeId> operator[](std::size_t c) const {
+    if (c < mesh.tets.size()) return mesh.tets[c];
+    c -= mesh.tets.size();
+    if (c < mesh.pyramids.size()) return mesh.pyramids[c];
+    return mesh.hexes[c - mesh.pyramids.size()];
+  }
+};
+
+// node → items, compressed rows.
+struct NodeItems {
+  std::vector<std::size_t> start;
+  std::vector<std::int32_t> item;
+  template <class Nodes>
+  void build(std::size_t nodes, std::size_t items, const Nodes& nodes_of) {
+    start.assign(nodes + 1, 0);
+    for (std::size_t i = 0; i < items; ++i)
+      for (NodeId n : nodes_of(i)) ++start[static_cast<std::size_t>(n) + 1];
+    for (std::size_t n = 0; n < nodes; ++n) start[n + 1] += start[n];
+    item.resize(start[nodes]);
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < items; ++i)
+      for (NodeId n : nodes_of(i)) item[fill[n]++] = static_cast<std::int32_t>(i);
+  }
+  std::span<const std::int32_t> of(NodeId n) const {
+    return {item.data() + start[n], start[static_cast<std::size_t>(n) + 1] - start[n]};
+  }
+};
+
+double volume6(const Vec& a, const Vec& b, const Vec& c, const Vec& d) {
+  return (b - a).cross(c - a).dot(d - a);
+}
+
+// A cell's score: the smallest of its metrics over their targets (1 meets every target), or
+// −1 when it is inverted or flat. `at` gives node positions.
+class Scorer {
+ public:
+  explicit Scorer(const RelocateOptions& o)
+      : dihedral_(o.min_dihedral), jacobian_(o.min_scaled_jacobian), ratio_(o.max_edge_ratio) {}
+
+  template <class At>
+  double operator()(std::span<const NodeId> v, const At& at) const {
+    std::array<Vec, 8> x;
+    for (std::size_t k = 0; k < v.size(); ++k) x[k] = at(v[k]);
+    return v.size() == 4 ? tet(x) : v.size() == 5 ? pyramid(x) : hex(x);
+  }
+
+ private:
+  double tet(const std::array<Vec, 8>& x) const {
+    if (!(volume6(x[0], x[1], x[2], x[3]) > 0.0)) return -1.0;
+    std::array<Vec, 4> n;
+    for (int f = 0; f < 4; ++f) {
+      const auto& v = kTetFaces[f].v;
+      n[f] = (x[v[1]] - x[v[0]]).cross(x[v[2]] - x[v[0]]).normalized();
+    }
+    // Every two faces of a tetrahedron meet at an edge; the dihedral angle is π minus the angle
+    // between their outward normals.
+    double cos_max = -1.0;
+    for (int f = 0; f < 4; ++f)
+      for (int g = f + 1; g < 4; ++g) cos_max = std::max(cos_max, -n[f].dot(n[g]));
+    const double dihedral = std::acos(std::clamp(cos_max, -1.0, 1.0)) * kDegreesPerRadian;
+    constexpr int corners[4][4] = {{0, 1, 2, 3}, {1, 2, 0, 3}, {2, 0, 1, 3}, {3, 0, 2, 1}};
+    return std::min({dihedral / dihedral_, jacobian(x, corners) / jacobian_,
+                     ratio_ / edge_ratio(x, kTetEdges)});
+  }
+  double pyramid(const std::array<Vec, 8>& x) const {
+    // Both diagonal splits of the base must be positive.
+    if (!(std::min({volume6(x[0], x[1], x[2], x[4]), volume6(x[0], x[2], x[3], x[4]),
+                    volume6(x[0], x[1], x[3], x[4]), volume6(x[1], x[2], x[3], x[4])}) > 0.0))
+      return -1.0;
+    constexpr int corners[4][4] = {{0, 1, 3, 4}, {1, 2, 0, 4}, {2, 3, 1, 4}, {3, 0, 2, 4}};
+    return std::min(jacobian(x, corners) / jacobian_, ratio_ / edge_ratio(x, kPyramidEdges));
+  }
+  double hex(const std::array<Vec, 8>& x) const {
+    constexpr int corners[8][4] = {{0, 1, 3, 4}, {1, 2, 0, 5}, {2, 3, 1, 6}, {3, 0, 2, 7},
+                                   {4, 7, 5, 0}, {5, 4, 6, 1}, {6, 5, 7, 2}, {7, 6, 4, 3}};
+    const double j = jacobian(x, corners) / std::numbers::sqrt2;
+    if (!(j > 0.0)) return -1.0;
+    return std::min(j / jacobian_, ratio_ / edge_ratio(x, kHexEdges));
+  }
+  // The smallest corner Jacobian over the edge lengths, scaled to 1 for the regular cell (the
+  // quality report's scaled Jacobian).
+  template <std::size_t N>
+  static double jacobian(const std::array<Vec, 8>& x, const int (&corners)[N][4]) {
+    double j = INFINITY;
+    for (const auto& c : corners) {
+      const Vec a = x[c[1]] - x[c[0]], b = x[c[2]] - x[c[0]], e = x[c[3]] - x[c[0]];
+      const double norms = a.norm() * b.norm() * e.norm();
+      j = std::min(j, norms > 0.0 ? a.cross(b).dot(e) / norms : 0.0);
+    }
+    return j * std::numbers::sqrt2;
+  }
+  template <std::size_t E>
+  static double edge_ratio(const std::array<Vec, 8>& x,
+                           const std::array<std::array<int, 2>, E>& edges) {
+    double lo = INFINITY, hi = 0.0;
+    for (const auto& e : edges) {
+      const double l = (x[e[0]] - x[e[1]]).squaredNorm();
+      lo = std::min(lo, l);
+      hi = std::max(hi, l);
+    }
+    return lo > 0.0 ? std::sqrt(hi / lo) : INFINITY;
+  }
+
+  double dihedral_, jacobian_, ratio_;
+};
+
+// Moves p onto the level zero by Newton steps along the gradient; false when it leaves the
+// function's domain, does not settle, or ends farther than `reach` from where it started.
+bool project(const LevelSet& wall, Vec& p, double reach) {
+  const Vec start = p;
+  for (int it = 0; it < 12; ++it) {
+    double value;
+    Vec gradient;
+    if (!wall.evaluate(p, value, gradient)) return false;
+    const double g2 = gradient.squaredNorm();
+    if (!(g2 > 0.0)) return false;
+    const Vec step = value / g2 * gradient;
+    p -= step;
+    if (step.norm() <= 1e-10 * reach) return (p - start).norm() <= reach;
+  }
+  return false;
+}
+
+class Relocator {
+ public:
+  Relocator(HybridMesh& mesh, const LevelSet* wall, const std::vector<bool>& on_surface,
+            const RelocateOptions& options)
+      : mesh_(mesh), cells_{mesh}, wall_(wall), score_(options) {
+    const std::size_t n_nodes = mesh.nodes.size();
+    // A node's patch: -1 interior, ≥ 0 one patch, -2 on a line between patches.
+    std::vector<std::int32_t> patch(n_nodes, -1);
+    for_each_boundary_face(std::as_const(mesh), [&](std::span<const NodeId> f, std::int32_t p) {
+      for (NodeId n : f) patch[n] = patch[n] == -1 || patch[n] == p ? p : -2;
+    });
+    freedom_.assign(n_nodes, Freedom::interior);
+    for (std::size_t n = 0; n < n_nodes; ++n) {
+      const auto p = patch[n];
+      if (p == -2 || (p >= 0 && !(wall && static_cast<std::size_t>(p) < on_surface.size() &&
+                                  on_surface[static_cast<std::size_t>(p)])))
+        freedom_[n] = Freedom::fixed;
+      else if (p >= 0)
+        freedom_[n] = Freedom::surface;
+    }
+    // The hexahedra of the interior keep their shape: a node used by hexahedra only stays.
+    std::vector<char> other(n_nodes, 0);
+    for (const auto& t : mesh.tets)
+      for (NodeId n : t) other[n] = 1;
+    for (const auto& p : mesh.pyramids)
+      for (NodeId n : p) other[n] = 1;
+    for (std::size_t n = 0; n < n_nodes; ++n)
+      if (!other[n]) freedom_[n] = Freedom::fixed;
+    node_cells_.build(n_nodes, cells_.count(), [&](std::size_t c) { return cells_[c]; });
+    const std::size_t tris = mesh.boundary_tris.size();
+    node_faces_.build(n_nodes, tris + mesh.boundary_quads.size(),
+                      [&](std::size_t f) { return face(f); });
+  }
+
+  RelocateStats run(int sweeps, std::vector<std::int64_t>* unchanged_from) {
+    RelocateStats stats;
+    const std::size_t n_cells = cells_.count();
+    score_of_.resize(n_cells);
+    auto at = [&](NodeId n) -> const Vec& { return mesh_.nodes[n]; };
+    for (std::size_t c = 0; c < n_cells; ++c)
+      score_of_[c] = static_cast<float>(score_(cells_[c], at));
+    auto summarize = [&](std::size_t& below, double& worst) {
+      below = 0;
+      worst = INFINITY;
+      for (float s : score_of_) {
+        below += s < 1.0f;
+        worst = std::min(worst, static_cast<double>(s));
+      }
+    };
+    summarize(stats.cells_below_before, stats.worst_before);
+
+    // A node is tried again only after a neighbour moved.
+    std::vector<char> moved(mesh_.nodes.size(), 0), stale(mesh_.nodes.size(), 1);
+    std::vector<std::pair<float, NodeId>> queue;
+    for (int sweep = 0; sweep < sweeps; ++sweep) {
+      // The movable nodes of cells below target, worst first, once each.
+      queue.clear();
+      for (std::size_t c = 0; c < n_cells; ++c)
+        if (score_of_[c] < 1.0f)
+          for (NodeId n : cells_[c])
+            if (freedom_[n] != Freedom::fixed && stale[n]) queue.push_back({score_of_[c], n});
+      std::sort(queue.begin(), queue.end());
+      for (const auto& entry : queue) stale[entry.second] = 0;
+      std::size_t moves = 0;
+      for (const auto& [s, n] : queue) {
+        (void)s;
+        if (!improve(n)) continue;
+        ++moves;
+        moved[n] = 1;
+        for (auto c : node_cells_.of(n)) {
+          score_of_[c] = static_cast<float>(score_(cells_[c], at));
+          for (NodeId m : cells_[c]) stale[m] = 1;
+        }
+      }
+      stats.moves += moves;
+      if (moves == 0) break;
+    }
+    summarize(stats.cells_below_after, stats.worst_after);
+
+    for (std::size_t n = 0; n < moved.size(); ++n) {
+      if (!moved[n]) continue;
+      ++stats.nodes_moved;
+      if (unchanged_from)
+        for (auto c : node_cells_.of(static_cast<NodeId>(n)))
+          (*unchanged_from)[static_cast<std::size_t>(c)] = -1;
+      double value;
+      Vec gradient;
+      if (freedom_[n] == Freedom::surface && wall_->evaluate(mesh_.nodes[n], value, gradient))
+        stats.largest_surface_offset =
+            std::max(stats.largest_surface_offset, std::abs(value) / gradient.norm());
+    }
+    return stats;
+  }
+
+ private:
+  std::span<const NodeId> face(std::size_t f) const {
+    const std::size_t tris = mesh_.boundary_tris.size();
+    if (f < tris) return mesh_.boundary_tris[f];
+    return mesh_.boundary_quads[f - tris];
+  }
+
+  // The lowest score of n's cells with n at p, stopping as soon as one is at or below `floor`;
+  // −∞ when a cell that meets the targets would no longer meet them.
+  double worst_around(NodeId n, const Vec& p, double floor) const {
+    auto at = [&](NodeId m) -> const Vec& { return m == n ? p : mesh_.nodes[m]; };
+    double worst = INFINITY;
+    for (auto c : node_cells_.of(n)) {
+      const double s = score_(cells_[static_cast<std::size_t>(c)], at);
+      if (s < 1.0 && score_of_[static_cast<std::size_t>(c)] >= 1.0f) return -INFINITY;
+      worst = std::min(worst, s);
+      if (worst <= floor) break;
+    }
+    return worst;
+  }
+
+  // The boundary faces around a surface node keep their orientation (within 60°).
+  bool faces_keep_orientation(NodeId n, const Vec& p) const {
+    for (auto f : node_faces_.of(n)) {
+      const auto v = face(static_cast<std::size_t>(f));
+      auto normal = [&](auto&& at) {
+        if (v.size() == 3) return Vec((at(v[1]) - at(v[0])).cross(at(v[2]) - at(v[0])));
+        return Vec((at(v[2]) - at(v[0])).cross(at(v[3]) - at(v[1])));
+      };
+      const Vec before = normal([&](NodeId m) -> const Vec& { return mesh_.nodes[m]; });
+      const Vec after = normal([&](NodeId m) -> const Vec& { return m == n ? p : mesh_.nodes[m]; });
+      if (!(after.dot(before) > 0.5 * after.norm() * before.norm())) return false;
+    }
+    return true;
+  }
+
+  // Pattern search for the position of n that maximizes the lowest score of its cells: the
+  // gradient of the worst cell's score first, then the axes (or, on the wall, two tangents),
+  // halving the step when nothing improves. Returns whether n moved.
+  bool improve(NodeId n) {
+    const auto around = node_cells_.of(n);
+    if (around.empty()) return false;
+    const Vec origin = mesh_.nodes[n];
+    // The mean distance to the other nodes of its cells sets the step sizes.
+    double length = 0.0;
+    std::size_t neighbours = 0;
+    for (auto c : around)
+      for (NodeId m : cells_[static_cast<std::size_t>(c)])
+        if (m != n) {
+          length += (mesh_.nodes[m] - origin).norm();
+          ++neighbours;
+        }
+    length /= static_cast<double>(neighbours);
+
+    Vec x = origin;
+    double best = worst_around(n, x, -INFINITY);
+    if (best >= 1.0) return false;
+    const bool surface = freedom_[n] == Freedom::surface;
+    double h = 0.25 * length;
+    bool moved = false;
+    for (int iteration = 0; iteration < 12 && h > 1e-3 * length; ++iteration) {
+      std::array<Vec, 7> directions;
+      int count = 0;
+      // The worst cell's score gradient, by forward differences.
+      {
+        std::int32_t worst_cell = around[0];
+        double worst = INFINITY;
+        auto at = [&](NodeId m) -> const Vec& { return m == n ? x : mesh_.nodes[m]; };
+        for (auto c : around) {
+          const double s = score_(cells_[static_cast<std::size_t>(c)], at);
+          if (s < worst) worst = s, worst_cell = c;
+        }
+        const double delta = 1e-5 * length;
+        Vec gradient;
+        for (int d = 0; d < 3; ++d) {
+          Vec y = x;
+          y[d] += delta;
+          auto moved_at = [&](NodeId m) -> const Vec& { return m == n ? y : mesh_.nodes[m]; };
+          gradient[d] =
+              (score_(cells_[static_cast<std::size_t>(worst_cell)], moved_at) - worst) / delta;
+        }
+        if (surface) {
+          double value;
+          Vec normal;
+          if (!wall_->evaluate(x, value, normal) || !(normal.squaredNorm() > 0.0)) return moved;
+          normal.normalize();
+          gradient -= gradient.dot(normal) * normal;
+          const Vec t1 = normal.unitOrthogonal(), t2 = normal.cross(t1);
+          directions = {gradient, t1, -t1, t2, -t2, Vec::Zero(), Vec::Zero()};
+          count = 5;
+        } else {
+          directions = {gradient,      Vec::UnitX(), -Vec::UnitX(), Vec::UnitY(),
+                        -Vec::UnitY(), Vec::UnitZ(), -Vec::UnitZ()};
+          count = 7;
+        }
+        if (directions[0].squaredNorm() > 0.0)
+          directions[0].normalize();
+        else
+          directions[0] = directions[--count];
+      }
+      Vec best_position = x;
+      bool improved = false;
+      for (int d = 0; d < count; ++d) {
+        Vec p = x + h * directions[d];
+        if (surface && (!project(*wall_, p, 2.0 * h) || !faces_keep_orientation(n, p))) continue;
+        const double s = worst_around(n, p, best);
+        if (s > best * (1.0 + 1e-9) + 1e-12) {
+          best = s;
+          best_position = p;
+          improved = true;
+          if (d == 0) break;  // the gradient step worked: take it
+        }
+      }
+      if (improved) {
+        x = best_position;
+        moved = true;
+        if (best >= 1.0) break;
+      } else {
+        h *= 0.5;
+      }
+    }
+    if (moved) mesh_.nodes[n] = x;
+    return moved;
+  }
+
+  HybridMesh& mesh_;
+  Cells cells_;
+  const LevelSet* wall_;
+  Scorer score_;
+  std::vector<Freedom> freedom_;
+  NodeItems node_cells_, node_faces_;
+  std::vector<float> score_of_;  // of every cell, as the nodes stand
+};
+
+// Tetrahedra below target with two or three faces on one surface patch are removed: all their
+// nodes lie on the wall, so no relocation can lift them, and the wall is the same surface after
+// (its triangulation flips an edge, or loses a cap). Two faces abc, abd: the faces acd and bcd
+// become the wall, unless cd is a wall edge already (it would join four faces). Three faces:
+// their common node leaves the mesh with the cell, if no other cell uses it.
+std::size_t remove_boundary_slivers(HybridMesh& mesh, const std::vector<bool>& on_surface,
+                                    const Scorer& score,
+                                    std::vector<std::int64_t>* unchanged_from) {
+  using Key = std::array<NodeId, 3>;
+  auto sorted = [](Key k) {
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      return (static_cast<std::size_t>(k[0]) * 0x9E3779B97F4A7C15ull) ^
+             (static_cast<std::size_t>(k[1]) * 0xC2B2AE3D27D4EB4Full) ^
+             static_cast<std::size_t>(k[2]);
+    }
+  };
+  auto edge_key = [](NodeId a, NodeId b) {
+    return static_cast<std::uint64_t>(std::min(a, b)) << 32 |
+           static_cast<std::uint32_t>(std::max(a, b));
+  };
+  // Only tetrahedra below target whose nodes are all on the boundary are candidates; find them
+  // before building any table.
+  std::vector<char> on_boundary(mesh.nodes.size(), 0);
+  for (const auto& t : mesh.boundary_tris)
+    for (NodeId n : t) on_boundary[n] = 1;
+  auto at = [&](NodeId n) -> const Vec& { return mesh.nodes[n]; };
+  std::vector<std::size_t> candidates;
+  for (std::size_t c = 0; c < mesh.tets.size(); ++c) {
+    const auto& t = mesh.tets[c];
+    if (on_boundary[t[0]] && on_boundary[t[1]] && on_boundary[t[2]] && on_boundary[t[3]] &&
+        score(std::span<const NodeId>(t), at) < 1.0)
+      candidates.push_back(c);
+  }
+  if (candidates.empty()) return 0;
+
+  std::unordered_map<Key, std::int32_t, KeyHash> wall_tri;
+  std::unordered_map<std::uint64_t, int> wall_edge;  // boundary triangles on each edge
+  for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f) {
+    const auto& t = mesh.boundary_tris[f];
+    wall_tri[sorted(t)] = static_cast<std::int32_t>(f);
+    for (int k = 0; k < 3; ++k) ++wall_edge[edge_key(t[k], t[(k + 1) % 3])];
+  }
+  // Cells using each node (for the three-face case).
+  std::vector<std::int32_t> uses(mesh.nodes.size(), 0);
+  auto count_uses = [&](const auto& cells) {
+    for (const auto& c : cells)
+      for (NodeId n : c) ++uses[n];
+  };
+  count_uses(mesh.tets);
+  count_uses(mesh.pyramids);
+  count_uses(mesh.hexes);
+
+  std::vector<char> removed_tet(mesh.tets.size(), 0), removed_tri(mesh.boundary_tris.size(), 0);
+  std::size_t removed = 0;
+  for (std::size_t c : candidates) {
+    const auto t = mesh.tets[c];
+    std::array<std::int32_t, 4> wall_face{-1, -1, -1, -1};
+    int on_wall = 0;
+    std::int32_t patch = -1;
+    bool one_patch = true;
+    for (int f = 0; f < 4; ++f) {
+      const auto& v = kTetFaces[f].v;
+      const auto it = wall_tri.find(sorted({t[v[0]], t[v[1]], t[v[2]]}));
+      if (it == wall_tri.end()) continue;
+      wall_face[f] = it->second;
+      const std::int32_t p = mesh.boundary_tri_patch[static_cast<std::size_t>(it->second)];
+      one_patch = one_patch && (patch < 0 || p == patch);
+      patch = p;
+      ++on_wall;
+    }
+    if (on_wall < 2 || on_wall > 3 || !one_patch || !on_surface[static_cast<std::size_t>(patch)])
+      continue;
+    // The faces that become wall, reversed to face out of the remaining cells.
+    std::array<Key, 2> fresh;
+    int n_fresh = 0;
+    Vec old_normal = Vec::Zero();
+    for (int f = 0; f < 4; ++f) {
+      const auto& v = kTetFaces[f].v;
+      const Vec normal = (at(t[v[1]]) - at(t[v[0]])).cross(at(t[v[2]]) - at(t[v[0]]));
+      if (wall_face[f] >= 0)
+        old_normal += normal;
+      else
+        fresh[static_cast<std::size_t>(n_fresh++)] = {t[v[0]], t[v[2]], t[v[1]]};
+    }
+    bool ok = true;
+    for (int f = 0; f < n_fresh; ++f) {
+      const Key& k = fresh[static_cast<std::size_t>(f)];
+      const Vec normal = (at(k[1]) - at(k[0])).cross(at(k[2]) - at(k[0]));
+      ok = ok && normal.dot(old_normal) > 0.0;
+    }
+    if (on_wall == 2) {
+      // The edge of the two fresh faces must not be a wall edge yet.
+      const Key& k0 = fresh[0];
+      const Key& k1 = fresh[1];
+      std::array<NodeId, 2> shared{};
+      int n_shared = 0;
+      for (NodeId a : k0)
+        if (std::find(k1.begin(), k1.end(), a) != k1.end() && n_shared < 2) shared[n_shared++] = a;
+      const auto it = wall_edge.find(edge_key(shared[0], shared[1]));
+      ok = ok && n_shared == 2 && (it == wall_edge.end() || it->second == 0);
+    } else {
+      // The node common to the three wall faces goes with the cell.
+      NodeId apex = -1;
+      for (NodeId n : t) {
+        bool in_all = true;
+        for (int f = 0; f < 4; ++f)
+          if (wall_face[f] < 0) {
+            const auto& v = kTetFaces[f].v;
+            in_all = in_all && (t[v[0]] == n || t[v[1]] == n || t[v[2]] == n);
+          }
+        if (!in_all) apex = n;  // the one node missing from the fresh face
+      }
+      ok = ok && apex >= 0 && uses[apex] == 1;
+    }
+    if (!ok) continue;
+
+    removed_tet[c] = 1;
+    ++removed;
+    for (NodeId n : t) --uses[n];
+    for (int f = 0; f < 4; ++f) {
+      if (wall_face[f] < 0) continue;
+      const auto& tri = mesh.boundary_tris[static_cast<std::size_t>(wall_face[f])];
+      removed_tri[static_cast<std::size_t>(wall_face[f])] = 1;
+      wall_tri.erase(sorted(tri));
+      for (int k = 0; k < 3; ++k) --wall_edge[edge_key(tri[k], tri[(k + 1) % 3])];
+    }
+    for (int f = 0; f < n_fresh; ++f) {
+      const Key& k = fresh[static_cast<std::size_t>(f)];
+      wall_tri[sorted(k)] = static_cast<std::int32_t>(mesh.boundary_tris.size());
+      mesh.boundary_tris.push_back(k);
+      mesh.boundary_tri_patch.push_back(patch);
+      removed_tri.push_back(0);
+      for (int e = 0; e < 3; ++e) ++wall_edge[edge_key(k[e], k[(e + 1) % 3])];
+    }
+  }
+  if (removed == 0) return 0;
+
+  // The removed tetrahedra leave the cell list (and unchanged_from, whose first entries are
+  // the tetrahedra), the removed triangles the boundary.
+  std::size_t kept = 0;
+  for (std::size_t c = 0; c < mesh.tets.size(); ++c) {
+    if (removed_tet[c]) continue;
+    mesh.tets[kept] = mesh.tets[c];
+    if (unchanged_from) (*unchanged_from)[kept] = (*unchanged_from)[c];
+    ++kept;
+  }
+  if (unchanged_from)
+    unchanged_from->erase(unchanged_from->begin() + static_cast<std::ptrdiff_t>(kept),
+                          unchanged_from->begin() + static_cast<std::ptrdiff_t>(mesh.tets.size()));
+  mesh.tets.resize(kept);
+  kept = 0;
+  for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f) {
+    if (removed_tri[f]) continue;
+    mesh.boundary_tris[kept] = mesh.boundary_tris[f];
+    mesh.boundary_tri_patch[kept] = mesh.boundary_tri_patch[f];
+    ++kept;
+  }
+  mesh.boundary_tris.resize(kept);
+  mesh.boundary_tri_patch.resize(kept);
+  compact_nodes(mesh);
+  return removed;
+}
+
+}  // namespace
+
+RelocateStats relocate_nodes(HybridMesh& mesh, const LevelSet* wall,
+                             const std::vector<bool>& on_surface, const RelocateOptions& options,
+                             std::vector<std::int64_t>* unchanged_from) {
+  Stopwatch clock;
+  const Scorer score(options);
+  std::size_t removed = remove_boundary_slivers(mesh, on_surface, score, unchanged_from);
+  RelocateStats stats =
+      Relocator(mesh, wall, on_surface, options).run(options.sweeps, unchanged_from);
+  removed += remove_boundary_slivers(mesh, on_surface, score, unchanged_from);
+  stats.slivers_removed = removed;
+  stats.seconds = clock.seconds();
+  return stats;
+}
+
+}  // namespace naris
