@@ -48,10 +48,6 @@ struct NodeItems {
   }
 };
 
-double volume6(const Vec& a, const Vec& b, const Vec& c, const Vec& d) {
-  return (b - a).cross(c - a).dot(d - a);
-}
-
 // A cell's score: the smallest of its metrics over their targets (1 meets every target), or
 // −1 when it is inverted or flat. `at` gives node positions.
 class Scorer {
@@ -68,7 +64,7 @@ class Scorer {
 
  private:
   double tet(const std::array<Vec, 8>& x) const {
-    if (!(volume6(x[0], x[1], x[2], x[3]) > 0.0)) return -1.0;
+    if (!(tet_volume(x[0], x[1], x[2], x[3]) > 0.0)) return -1.0;
     std::array<Vec, 4> n;
     for (int f = 0; f < 4; ++f) {
       const auto& v = kTetFaces[f].v;
@@ -86,8 +82,8 @@ class Scorer {
   }
   double pyramid(const std::array<Vec, 8>& x) const {
     // Both diagonal splits of the base must be positive.
-    if (!(std::min({volume6(x[0], x[1], x[2], x[4]), volume6(x[0], x[2], x[3], x[4]),
-                    volume6(x[0], x[1], x[3], x[4]), volume6(x[1], x[2], x[3], x[4])}) > 0.0))
+    if (!(std::min({tet_volume(x[0], x[1], x[2], x[4]), tet_volume(x[0], x[2], x[3], x[4]),
+                    tet_volume(x[0], x[1], x[3], x[4]), tet_volume(x[1], x[2], x[3], x[4])}) > 0.0))
       return -1.0;
     constexpr int corners[4][4] = {{0, 1, 3, 4}, {1, 2, 0, 4}, {2, 3, 1, 4}, {3, 0, 2, 4}};
     return std::min(jacobian(x, corners) / jacobian_, ratio_ / edge_ratio(x, kPyramidEdges));
@@ -207,8 +203,7 @@ class Relocator {
       std::sort(queue.begin(), queue.end());
       for (const auto& entry : queue) stale[entry.second] = 0;
       std::size_t moves = 0;
-      for (const auto& [s, n] : queue) {
-        (void)s;
+      for (const auto& [worst, n] : queue) {
         if (!improve(n)) continue;
         ++moves;
         moved[n] = 1;
