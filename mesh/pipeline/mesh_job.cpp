@@ -178,6 +178,8 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
   MeshJobResult r;
   Stopwatch total;
   // Each level multiplies the cells by 8: three turn a 10⁶-cell mesh into 5·10⁸.
+  if (job.relocate && !job.improve)
+    fail("relocate follows the improvement's collapses: drop --no-improve (improve: false)");
   if (job.subdivisions < 0 || job.subdivisions > 3)
     fail("subdivide is {}: give 0 to 3 levels (each multiplies the cells by 8)", job.subdivisions);
   ensure_writable_folder(job.output.parent_path());
@@ -308,30 +310,36 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
                        {"hydraulic_diameter_mm", significant(p.hydraulic_diameter())}});
   for (const auto& [stage, t] : r.seconds) seconds[stage] = significant(t, 5);
   const ImproveStats& im = r.improvement;
-  const Json json = {
-      {"input", job.input.string()},
-      {"mode", inside_rule_name(r.rule)},
-      {"level", r.level},
-      {"nodes", r.mesh.nodes.size()},
-      {"cells",
-       {{"tet", r.mesh.tets.size()},
-        {"pyramid", r.mesh.pyramids.size()},
-        {"hex", r.mesh.hexes.size()}}},
-      {"boundary_faces",
-       {{"tri", r.mesh.boundary_tris.size()}, {"quad", r.mesh.boundary_quads.size()}}},
-      {"volume_mm3", significant(r.volume)},
-      {"components", r.mve.components},
-      {"dropped_components", r.mve.dropped_components},
-      {"dropped_cells", r.mve.dropped_cells},
-      {"improvement",
-       {{"short_edges", im.short_edges},
-        {"collapsed", im.collapsed},
-        {"refused_topology", im.refused_topology},
-        {"refused_geometry", im.refused_geometry},
-        {"removed_cells", im.removed_cells},
-        {"pyramids_to_tets", im.pyramids_to_tets}}},
-      {"relocation",
-       {{"cells_below_target_before", r.relocation.cells_below_before},
+  Json json = {{"input", job.input.string()},
+               {"mode", inside_rule_name(r.rule)},
+               {"level", r.level},
+               {"nodes", r.mesh.nodes.size()},
+               {"cells",
+                {{"tet", r.mesh.tets.size()},
+                 {"pyramid", r.mesh.pyramids.size()},
+                 {"hex", r.mesh.hexes.size()}}},
+               {"boundary_faces",
+                {{"tri", r.mesh.boundary_tris.size()}, {"quad", r.mesh.boundary_quads.size()}}},
+               {"volume_mm3", significant(r.volume)},
+               {"components", r.mve.components},
+               {"dropped_components", r.mve.dropped_components},
+               {"dropped_cells", r.mve.dropped_cells},
+               {"improvement",
+                {{"short_edges", im.short_edges},
+                 {"collapsed", im.collapsed},
+                 {"refused_topology", im.refused_topology},
+                 {"refused_geometry", im.refused_geometry},
+                 {"removed_cells", im.removed_cells},
+                 {"pyramids_to_tets", im.pyramids_to_tets}}},
+               {"patches", patches},
+               {"outlet_extension_mm", significant(r.extension.length_mm)},
+               {"quality_before", quality_json(r.before)},
+               {"quality_after", quality_json(r.after)},
+               {"seconds", seconds},
+               {"peak_memory_mb", significant(megabytes(peak_memory_bytes()), 5)}};
+  if (job.relocate)
+    json["relocation"] = {
+        {"cells_below_target_before", r.relocation.cells_below_before},
         {"cells_below_target_after", r.relocation.cells_below_after},
         {"worst_score_before", significant(r.relocation.worst_before)},
         {"worst_score_after", significant(r.relocation.worst_after)},
@@ -339,13 +347,7 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
         {"moves", r.relocation.moves},
         {"slivers_removed", r.relocation.slivers_removed},
         {"largest_surface_offset_mm", significant(r.relocation.largest_surface_offset)},
-        {"seconds", significant(r.relocation.seconds, 5)}}},
-      {"patches", patches},
-      {"outlet_extension_mm", significant(r.extension.length_mm)},
-      {"quality_before", quality_json(r.before)},
-      {"quality_after", quality_json(r.after)},
-      {"seconds", seconds},
-      {"peak_memory_mb", significant(megabytes(peak_memory_bytes()), 5)}};
+        {"seconds", significant(r.relocation.seconds, 5)}};
   write_json_file(sibling("mesh.json"), json);
   r.written.push_back(sibling("mesh.json").string());
 }
@@ -396,7 +398,7 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
         "pyramids → tets\n",
         r.improvement.collapsed, r.improvement.refused_topology + r.improvement.refused_geometry,
         r.improvement.removed_cells, r.improvement.pyramids_to_tets);
-  if (job.improve && job.relocate)
+  if (job.relocate)
     s += fmt::format(
         "  relocated {} nodes, removed {} wall slivers: cells below target {} → {}, worst score "
         "{:.3f} → {:.3f}\n",

@@ -180,15 +180,6 @@ class Relocator {
     auto at = [&](NodeId n) -> const Vec& { return mesh_.nodes[n]; };
     for (std::size_t c = 0; c < n_cells; ++c)
       score_of_[c] = static_cast<float>(score_(cells_[c], at));
-    auto summarize = [&](std::size_t& below, double& worst) {
-      below = 0;
-      worst = INFINITY;
-      for (float s : score_of_) {
-        below += s < 1.0f;
-        worst = std::min(worst, static_cast<double>(s));
-      }
-    };
-    summarize(stats.cells_below_before, stats.worst_before);
 
     // A node is tried again only after a neighbour moved.
     std::vector<char> moved(mesh_.nodes.size(), 0), stale(mesh_.nodes.size(), 1);
@@ -201,7 +192,13 @@ class Relocator {
           for (NodeId n : cells_[c])
             if (freedom_[n] != Freedom::fixed && stale[n]) queue.push_back({score_of_[c], n});
       std::sort(queue.begin(), queue.end());
-      for (const auto& entry : queue) stale[entry.second] = 0;
+      std::size_t kept = 0;
+      for (const auto& entry : queue)
+        if (stale[entry.second]) {
+          stale[entry.second] = 0;
+          queue[kept++] = entry;
+        }
+      queue.resize(kept);
       std::size_t moves = 0;
       for (const auto& [worst, n] : queue) {
         if (!improve(n)) continue;
@@ -215,7 +212,6 @@ class Relocator {
       stats.moves += moves;
       if (moves == 0) break;
     }
-    summarize(stats.cells_below_after, stats.worst_after);
 
     for (std::size_t n = 0; n < moved.size(); ++n) {
       if (!moved[n]) continue;
@@ -533,6 +529,19 @@ std::size_t remove_boundary_slivers(HybridMesh& mesh, const std::vector<bool>& o
   return removed;
 }
 
+// How many cells are below target, and the lowest score.
+void summarize(const HybridMesh& mesh, const Scorer& score, std::size_t& below, double& worst) {
+  const Cells cells{mesh};
+  auto at = [&](NodeId n) -> const Vec& { return mesh.nodes[n]; };
+  below = 0;
+  worst = INFINITY;
+  for (std::size_t c = 0; c < cells.count(); ++c) {
+    const double s = score(cells[c], at);
+    below += s < 1.0;
+    worst = std::min(worst, s);
+  }
+}
+
 }  // namespace
 
 RelocateStats relocate_nodes(HybridMesh& mesh, const LevelSet* wall,
@@ -540,11 +549,17 @@ RelocateStats relocate_nodes(HybridMesh& mesh, const LevelSet* wall,
                              std::vector<std::int64_t>* unchanged_from) {
   Stopwatch clock;
   const Scorer score(options);
+  std::size_t below_before;
+  double worst_before;
+  summarize(mesh, score, below_before, worst_before);
   std::size_t removed = remove_boundary_slivers(mesh, on_surface, score, unchanged_from);
   RelocateStats stats =
       Relocator(mesh, wall, on_surface, options).run(options.sweeps, unchanged_from);
   removed += remove_boundary_slivers(mesh, on_surface, score, unchanged_from);
   stats.slivers_removed = removed;
+  stats.cells_below_before = below_before;
+  stats.worst_before = worst_before;
+  summarize(mesh, score, stats.cells_below_after, stats.worst_after);
   stats.seconds = clock.seconds();
   return stats;
 }

@@ -6,7 +6,9 @@
 #include <array>
 #include <cmath>
 
+#include "core/error.h"
 #include "mesh/mve/mve.h"
+#include "mesh/pipeline/mesh_job.h"
 #include "mesh/quality/check.h"
 #include "mesh/quality/improve.h"
 #include "mesh/quality/relocate.h"
@@ -85,6 +87,19 @@ TEST(Relocate, SphereSignedDistanceImprovesAndStaysOnTheSurface) {
   }
   EXPECT_GT(interior, 0u);
   EXPECT_EQ(mesh.hexes.size(), before.hexes.size());
+}
+
+TEST(Relocate, WithoutTheImprovementIsRefused) {
+  MeshJob job;
+  job.input = "absent.nrrd";
+  job.improve = false;
+  job.relocate = true;
+  try {
+    run_mesh_job(job);
+    ADD_FAILURE() << "relocation without the improvement was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--no-improve"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
