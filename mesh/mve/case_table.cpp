@@ -341,12 +341,12 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
       mid.fill(0.5);
       Points pts;
       sample_points(entry, mid, pts);
+      double best_shape = -INFINITY;
       for (std::size_t r = 0; r < std::min<std::size_t>(ranked.size(), 6); ++r) {
         Points copy = pts;
-        if (place_and_measure(ranked[r].second, copy) > 6e-12) {
-          comp.midpoint_candidate = static_cast<int>(r);
-          break;
-        }
+        if (!(place_and_measure(ranked[r].second, copy) > 6e-12)) continue;
+        const double shape = worst_shape(ranked[r].second, copy);
+        if (shape > best_shape) best_shape = shape, comp.midpoint_candidate = static_cast<int>(r);
       }
     }
     comp.face_polygons = cpolys;

@@ -67,15 +67,15 @@ struct Tessellation {
 };
 
 struct Component {
-  // Alternatives in order of preference; the mesher takes the first whose cells all have
-  // positive volume for the actual isopoint positions.
+  // Alternatives, the most robust first; the mesher takes, of those whose cells all have
+  // positive volume for the actual isopoint positions, the one whose worst cell is best shaped.
   std::vector<Tessellation> candidates;
   // The component's boundary as the table sees it, for a search at run time when no candidate
   // fits (rare: components with two or more isosurface loops and extreme isopoints).
   std::vector<Polygon> face_polygons;
   std::vector<std::vector<std::uint8_t>> loops;  // outward oriented
-  // The first candidate valid when every isopoint is an edge midpoint (binary fields), where a
-  // cube's shape depends on its configuration alone; -1 if none (then chosen at run time).
+  // The candidate valid and best shaped when every isopoint is an edge midpoint (binary fields),
+  // where a cube's shape depends on its configuration alone; -1 if none (then chosen at run time).
   int midpoint_candidate = -1;
 };
 

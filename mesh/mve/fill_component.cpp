@@ -8,11 +8,21 @@ namespace {
 
 // Cells thinner than this (6× volume, in units of the voxel) count as invalid.
 constexpr double kMinVolume6 = 1e-12;
+// A valid candidate whose worst corner Jacobian reaches this is taken without trying the others:
+// the search for a better one then changes no measured quality (docs/results/relocation.md).
+constexpr double kGoodShape = 0.3;
 
 using Points = std::array<Eigen::Vector3d, kMaxLocalPoints>;
 
 double tet6(const Points& x, int a, int b, int c, int d) {
   return (x[b] - x[a]).cross(x[c] - x[a]).dot(x[d] - x[a]);
+}
+
+// The scaled Jacobian at corner a of the tetrahedron (a, b, c, d).
+double corner_jacobian(const Points& x, int a, int b, int c, int d) {
+  const Eigen::Vector3d e1 = x[b] - x[a], e2 = x[c] - x[a], e3 = x[d] - x[a];
+  const double l = e1.norm() * e2.norm() * e3.norm();
+  return l > 0 ? e1.cross(e2).dot(e3) / l : -1.0;
 }
 
 }  // namespace
@@ -174,18 +184,46 @@ bool search_apex(const Component& comp, const Eigen::Vector3d& cube_min, const P
 
 }  // namespace
 
+double worst_shape(const Tessellation& t, const Points& x) {
+  double q = INFINITY;
+  for (const auto& c : t.cells) {
+    const auto& p = c.p;
+    if (c.size == 4) {
+      q = std::min({q, corner_jacobian(x, p[0], p[1], p[2], p[3]),
+                    corner_jacobian(x, p[1], p[2], p[0], p[3]),
+                    corner_jacobian(x, p[2], p[0], p[1], p[3]),
+                    corner_jacobian(x, p[3], p[0], p[2], p[1])});
+    } else {
+      for (int k = 0; k < 4; ++k)
+        q = std::min(q, corner_jacobian(x, p[k], p[(k + 1) % 4], p[(k + 3) % 4], p[4]));
+    }
+  }
+  return q;
+}
+
 void fill_component(const Component& comp, const Eigen::Vector3d& cube_min, Points& x,
                     ComponentFill& out) {
   out.clear();
   const Tessellation* least_bad = nullptr;
   double best = -INFINITY;
+  const Tessellation* chosen = nullptr;
+  const Tessellation* placed = nullptr;  // whose private points x holds
+  double chosen_q = -INFINITY;
   for (const auto& cand : comp.candidates) {
     const double v = place_and_measure(cand, x);
+    placed = &cand;
     if (v > kMinVolume6) {
-      emit(cand, x, out);
-      return;
+      const double q = worst_shape(cand, x);
+      if (q > chosen_q) chosen_q = q, chosen = &cand;
+      if (q >= kGoodShape) break;
+      continue;
     }
     if (v > best) best = v, least_bad = &cand;
+  }
+  if (chosen) {
+    if (chosen != placed) place_and_measure(*chosen, x);
+    emit(*chosen, x, out);
+    return;
   }
   if (search_apex(comp, cube_min, x, out)) return;
   // Nothing valid: report it and emit the least inverted candidate so the caller can count it.

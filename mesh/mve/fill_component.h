@@ -1,7 +1,8 @@
 #pragma once
 // Fills one inside component of one cube with cells, given the positions of its local points:
-// the first table candidate whose cells all have positive volume, or else an apex found by a
-// small search (see fill_component.cpp). Shared by the mesher and the table tests.
+// the first table candidate whose cells all have positive volume and are well shaped, else the
+// best shaped of the valid ones, or else an apex found by a small search (see fill_component.cpp).
+// Shared by the mesher and the table tests.
 #include <Eigen/Dense>
 #include <array>
 #include <cstdint>
@@ -35,12 +36,16 @@ struct ComponentFill {
 void fill_component(const Component& comp, const Eigen::Vector3d& cube_min,
                     std::array<Eigen::Vector3d, kMaxLocalPoints>& x, ComponentFill& out);
 
-// For binary fields: the candidate known in advance to be valid at midpoint isopoints (its
-// private points are still placed from x). Falls back to fill_component when there is none.
 // Smallest 6× tetrahedron volume over a candidate's cells (both diagonal splits of each pyramid
 // base), after placing its private points in x (from id kPrivatePoint0 on).
 double place_and_measure(const Tessellation& t, std::array<Eigen::Vector3d, kMaxLocalPoints>& x);
+// The smallest corner Jacobian over a placed candidate's cells, e1·(e2×e3)/(|e1||e2||e3|) at
+// every corner of a tetrahedron and the four base corners of a pyramid: 1 for three
+// perpendicular edges, 0.71 at the regular tetrahedron's corners, ≤ 0 for an inverted corner.
+double worst_shape(const Tessellation& t, const std::array<Eigen::Vector3d, kMaxLocalPoints>& x);
 
+// For binary fields: the candidate chosen in advance at midpoint isopoints (its private points
+// are still placed from x). Falls back to fill_component when there is none.
 void fill_component_binary(const Component& comp, const Eigen::Vector3d& cube_min,
                            std::array<Eigen::Vector3d, kMaxLocalPoints>& x, ComponentFill& out);
 

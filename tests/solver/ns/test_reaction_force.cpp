@@ -110,17 +110,17 @@ Drag drag_at(int across, double re) {
   return d;
 }
 
-// The consistent drag changes monotonically with shrinking steps under refinement; the
-// patches' forces are minus the convective integral, which the residuals of all nodes sum to
-// (to the solver's tolerance), and close the momentum balance.
-TEST(ReactionForce, DragOnASphereInAPipeConvergesMonotonically) {
+// The consistent drag is converged at 6, 8 and 10 cells across the sphere: the three agree to
+// 1e-3 of their mean (meshes whose boundary cubes kept slivers spread by 2.6e-3, falling
+// monotonically towards the same value). The patches' forces are minus the convective integral,
+// which the residuals of all nodes sum to (to the solver's tolerance), and close the momentum
+// balance.
+TEST(ReactionForce, DragOnASphereInAPipeConverges) {
   const double re = 20.0;  // on the pipe's diameter and mean speed
   const Drag coarse = drag_at(6, re), middle = drag_at(8, re), fine = drag_at(10, re);
-  const double first = middle.consistent - coarse.consistent,
-               second = fine.consistent - middle.consistent;
-  EXPECT_GT(first * second, 0.0) << "not monotonic";
-  EXPECT_LT(std::abs(second), std::abs(first));
+  const double mean = (coarse.consistent + middle.consistent + fine.consistent) / 3.0;
   for (const Drag& d : {coarse, middle, fine}) {
+    EXPECT_LT(std::abs(d.consistent - mean), 1e-3 * mean);
     EXPECT_LT(d.identity, 1e-6);
     EXPECT_LT(d.balance, 1e-3);
   }
