@@ -329,7 +329,7 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
       Points pts;
       for (const auto& t : sampler.params) {
         sample_points(entry, t, pts);
-        if (!(place_and_measure(tess, pts) > 6e-14)) ++failures;  // 6× volume
+        if (!(place_and_measure(tess, pts, false).volume6 > 6e-14)) ++failures;  // 6× volume
       }
       ranked.push_back({{failures, static_cast<int>(tess.cells.size())}, std::move(tess)});
     }
@@ -344,9 +344,10 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
       double best_shape = -INFINITY;
       for (std::size_t r = 0; r < std::min<std::size_t>(ranked.size(), 6); ++r) {
         Points copy = pts;
-        if (!(place_and_measure(ranked[r].second, copy) > 6e-12)) continue;
-        const double shape = worst_shape(ranked[r].second, copy);
-        if (shape > best_shape) best_shape = shape, comp.midpoint_candidate = static_cast<int>(r);
+        const FillMeasure m = place_and_measure(ranked[r].second, copy);
+        if (!(m.volume6 > 6e-12)) continue;
+        if (m.shape > best_shape)
+          best_shape = m.shape, comp.midpoint_candidate = static_cast<int>(r);
       }
     }
     comp.face_polygons = cpolys;

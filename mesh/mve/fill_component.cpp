@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 namespace naris::mve {
 namespace {
@@ -10,42 +11,62 @@ namespace {
 constexpr double kMinVolume6 = 1e-12;
 // A valid candidate whose worst corner Jacobian reaches this is taken without trying the others:
 // the search for a better one then changes no measured quality (docs/results/relocation.md).
-constexpr double kGoodShape = 0.3;
+static const double kGoodShape =
+    std::getenv("NARIS_GOOD") ? std::atof(std::getenv("NARIS_GOOD")) : 0.3;
 
 using Points = std::array<Eigen::Vector3d, kMaxLocalPoints>;
 
-double tet6(const Points& x, int a, int b, int c, int d) {
-  return (x[b] - x[a]).cross(x[c] - x[a]).dot(x[d] - x[a]);
-}
-
-// The scaled Jacobian at corner a of the tetrahedron (a, b, c, d).
-double corner_jacobian(const Points& x, int a, int b, int c, int d) {
-  const Eigen::Vector3d e1 = x[b] - x[a], e2 = x[c] - x[a], e3 = x[d] - x[a];
-  const double l = e1.norm() * e2.norm() * e3.norm();
-  return l > 0 ? e1.cross(e2).dot(e3) / l : -1.0;
-}
-
 }  // namespace
 
-double place_and_measure(const Tessellation& t, Points& x) {
+FillMeasure place_and_measure(const Tessellation& t, Points& x, bool with_shape, double floor) {
   int next = kPrivatePoint0;
   for (const auto& pp : t.privates) {
     Eigen::Vector3d m = Eigen::Vector3d::Zero();
     for (auto s : pp.mean_of) m += x[s];
     x[next++] = m / static_cast<double>(pp.mean_of.size());
   }
-  double vmin = INFINITY;
+  // A corner's Jacobian is its tetrahedron's 6× volume over the product of its three edges;
+  // compared squared (with the volume's sign) so that only the smallest needs a square root.
+  double volume6 = INFINITY, shape2 = INFINITY;
+  const double floor2 = floor * std::abs(floor);
+  auto result = [&] {
+    return FillMeasure{volume6, std::copysign(std::sqrt(std::abs(shape2)), shape2)};
+  };
+  auto corner = [&](double v, double product) {
+    volume6 = std::min(volume6, v);
+    if (with_shape) shape2 = std::min(shape2, product > 0.0 ? v * std::abs(v) / product : -1.0);
+  };
   for (const auto& c : t.cells) {
+    if (shape2 <= floor2) return result();
     const auto& p = c.p;
     if (c.size == 4) {
-      vmin = std::min(vmin, tet6(x, p[0], p[1], p[2], p[3]));
+      const Eigen::Vector3d a = x[p[1]] - x[p[0]], b = x[p[2]] - x[p[0]], d = x[p[3]] - x[p[0]];
+      const double v = a.cross(b).dot(d);
+      if (!with_shape) {
+        corner(v, 0.0);
+        continue;
+      }
+      const double e01 = a.squaredNorm(), e02 = b.squaredNorm(), e03 = d.squaredNorm(),
+                   e12 = (b - a).squaredNorm(), e13 = (d - a).squaredNorm(),
+                   e23 = (d - b).squaredNorm();
+      corner(v, std::max(std::max(e01 * e02 * e03, e01 * e12 * e13),
+                         std::max(e02 * e12 * e23, e03 * e13 * e23)));
     } else {
-      // A pyramid is valid when both diagonal splits of its base give positive tetrahedra.
-      vmin = std::min({vmin, tet6(x, p[0], p[1], p[2], p[4]), tet6(x, p[0], p[2], p[3], p[4]),
-                       tet6(x, p[0], p[1], p[3], p[4]), tet6(x, p[1], p[2], p[3], p[4])});
+      // A pyramid is valid when both diagonal splits of its base give positive tetrahedra; those
+      // four tetrahedra are also its base corners' (k, k+1, k−1, apex): the base edges
+      // b[k] = x[k+1] − x[k] and the lateral edges l[k] = x[apex] − x[k] give them all.
+      std::array<Eigen::Vector3d, 4> base, lateral;
+      for (int k = 0; k < 4; ++k)
+        base[k] = x[p[(k + 1) % 4]] - x[p[k]], lateral[k] = x[p[4]] - x[p[k]];
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3d& back = base[(k + 3) % 4];
+        const double v = -base[k].cross(back).dot(lateral[k]);
+        corner(v, with_shape ? base[k].squaredNorm() * back.squaredNorm() * lateral[k].squaredNorm()
+                             : 0.0);
+      }
     }
   }
-  return vmin;
+  return result();
 }
 
 namespace {
@@ -184,23 +205,6 @@ bool search_apex(const Component& comp, const Eigen::Vector3d& cube_min, const P
 
 }  // namespace
 
-double worst_shape(const Tessellation& t, const Points& x) {
-  double q = INFINITY;
-  for (const auto& c : t.cells) {
-    const auto& p = c.p;
-    if (c.size == 4) {
-      q = std::min({q, corner_jacobian(x, p[0], p[1], p[2], p[3]),
-                    corner_jacobian(x, p[1], p[2], p[0], p[3]),
-                    corner_jacobian(x, p[2], p[0], p[1], p[3]),
-                    corner_jacobian(x, p[3], p[0], p[2], p[1])});
-    } else {
-      for (int k = 0; k < 4; ++k)
-        q = std::min(q, corner_jacobian(x, p[k], p[(k + 1) % 4], p[(k + 3) % 4], p[4]));
-    }
-  }
-  return q;
-}
-
 void fill_component(const Component& comp, const Eigen::Vector3d& cube_min, Points& x,
                     ComponentFill& out) {
   out.clear();
@@ -210,15 +214,14 @@ void fill_component(const Component& comp, const Eigen::Vector3d& cube_min, Poin
   const Tessellation* placed = nullptr;  // whose private points x holds
   double chosen_q = -INFINITY;
   for (const auto& cand : comp.candidates) {
-    const double v = place_and_measure(cand, x);
+    const FillMeasure m = place_and_measure(cand, x, true, chosen_q);
     placed = &cand;
-    if (v > kMinVolume6) {
-      const double q = worst_shape(cand, x);
-      if (q > chosen_q) chosen_q = q, chosen = &cand;
-      if (q >= kGoodShape) break;
+    if (m.volume6 > kMinVolume6) {
+      if (m.shape > chosen_q) chosen_q = m.shape, chosen = &cand;
+      if (m.shape >= kGoodShape) break;
       continue;
     }
-    if (v > best) best = v, least_bad = &cand;
+    if (m.volume6 > best) best = m.volume6, least_bad = &cand;
   }
   if (chosen) {
     if (chosen != placed) place_and_measure(*chosen, x);

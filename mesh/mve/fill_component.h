@@ -5,6 +5,7 @@
 // Shared by the mesher and the table tests.
 #include <Eigen/Dense>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -36,13 +37,20 @@ struct ComponentFill {
 void fill_component(const Component& comp, const Eigen::Vector3d& cube_min,
                     std::array<Eigen::Vector3d, kMaxLocalPoints>& x, ComponentFill& out);
 
-// Smallest 6× tetrahedron volume over a candidate's cells (both diagonal splits of each pyramid
-// base), after placing its private points in x (from id kPrivatePoint0 on).
-double place_and_measure(const Tessellation& t, std::array<Eigen::Vector3d, kMaxLocalPoints>& x);
-// The smallest corner Jacobian over a placed candidate's cells, e1·(e2×e3)/(|e1||e2||e3|) at
-// every corner of a tetrahedron and the four base corners of a pyramid: 1 for three
-// perpendicular edges, 0.71 at the regular tetrahedron's corners, ≤ 0 for an inverted corner.
-double worst_shape(const Tessellation& t, const std::array<Eigen::Vector3d, kMaxLocalPoints>& x);
+// A candidate's cells measured after placing its private points in x (from id kPrivatePoint0
+// on): the smallest 6× tetrahedron volume (both diagonal splits of each pyramid base) and the
+// smallest corner Jacobian e1·(e2×e3)/(|e1||e2||e3|), over every corner of its tetrahedra and the
+// four base corners of its pyramids (1 for three perpendicular edges, 0.71 at the regular
+// tetrahedron's corners, ≤ 0 for an inverted corner).
+struct FillMeasure {
+  double volume6;
+  double shape;
+};
+// Without `with_shape`, the shape is not computed (left +∞). The measurement stops at the first
+// cell that takes the shape to `floor` or below (the candidate cannot beat one of that shape).
+FillMeasure place_and_measure(const Tessellation& t,
+                              std::array<Eigen::Vector3d, kMaxLocalPoints>& x,
+                              bool with_shape = true, double floor = -INFINITY);
 
 // For binary fields: the candidate chosen in advance at midpoint isopoints (its private points
 // are still placed from x). Falls back to fill_component when there is none.
