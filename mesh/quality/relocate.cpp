@@ -14,7 +14,21 @@ namespace {
 using Vec = Eigen::Vector3d;
 constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
 
-enum class Freedom : std::uint8_t { fixed, interior, surface };
+// surface: slides on the wall's level zero; plane: moves in its flat patch (a cut plane, a box
+// side); rim: on the line where the wall meets a flat patch (in the plane, on the level zero).
+enum class Freedom : std::uint8_t { fixed, interior, surface, plane, rim };
+
+struct Plane {
+  Vec normal = Vec::Zero();  // unit
+  double offset = 0.0;       // normal·x on the plane
+  // p moved along the normal to the plane through `on` (exactly `on`'s coordinate for an axis).
+  Vec through(const Vec& p, const Vec& on) const {
+    Vec q = p - normal.dot(p - on) * normal;
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(normal[k]) == 1.0) q[k] = on[k];
+    return q;
+  }
+};
 
 // The cells of the mesh in its order (tetrahedra, pyramids, hexahedra) as node spans.
 struct Cells {
@@ -139,26 +153,83 @@ bool project(const LevelSet& wall, Vec& p, double reach) {
   return false;
 }
 
+// The plane of each patch whose faces all lie on one (to 1e-9 of the mesh's size); others get
+// a zero normal.
+std::vector<Plane> flat_patches(const HybridMesh& mesh) {
+  const std::size_t n_patches = mesh.patch_names.size();
+  std::vector<Vec> area(n_patches, Vec::Zero()), centre(n_patches, Vec::Zero());
+  std::vector<double> weight(n_patches, 0.0);
+  for_each_boundary_face(mesh, [&](std::span<const NodeId> f, std::int32_t p) {
+    const auto& x = mesh.nodes;
+    const Vec a = f.size() == 3 ? Vec((x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]))
+                                : Vec((x[f[2]] - x[f[0]]).cross(x[f[3]] - x[f[1]]));
+    area[p] += a;
+    for (NodeId n : f) centre[p] += x[n], weight[p] += 1.0;
+  });
+  std::vector<Plane> planes(n_patches);
+  for (std::size_t p = 0; p < n_patches; ++p) {
+    if (!(area[p].norm() > 0.0)) continue;
+    Vec normal = area[p].normalized();
+    // A plane along an image axis keeps its nodes' coordinate exactly.
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(normal[k]) > 1.0 - 1e-12) normal = Vec::Unit(k) * (normal[k] > 0 ? 1.0 : -1.0);
+    planes[p].normal = normal;
+    planes[p].offset = normal.dot(centre[p] / weight[p]);
+  }
+  Eigen::AlignedBox3d box;
+  for (const auto& x : mesh.nodes) box.extend(x);
+  const double tolerance = 1e-9 * box.diagonal().norm();
+  for_each_boundary_face(mesh, [&](std::span<const NodeId> f, std::int32_t p) {
+    for (NodeId n : f)
+      if (std::abs(planes[p].normal.dot(mesh.nodes[n]) - planes[p].offset) > tolerance)
+        planes[p].normal = Vec::Zero();
+  });
+  return planes;
+}
+
 class Relocator {
  public:
   Relocator(HybridMesh& mesh, const LevelSet* wall, const std::vector<bool>& on_surface,
             const RelocateOptions& options)
       : mesh_(mesh), cells_{mesh}, wall_(wall), score_(options) {
     const std::size_t n_nodes = mesh.nodes.size();
-    // A node's patch: -1 interior, ≥ 0 one patch, -2 on a line between patches.
-    std::vector<std::int32_t> patch(n_nodes, -1);
+    // A node's patches: none (-1), one, two, or more (the second -2).
+    std::vector<std::array<std::int32_t, 2>> patch(n_nodes, {-1, -1});
     for_each_boundary_face(std::as_const(mesh), [&](std::span<const NodeId> f, std::int32_t p) {
-      for (NodeId n : f) patch[n] = patch[n] == -1 || patch[n] == p ? p : -2;
+      for (NodeId n : f) {
+        auto& [a, b] = patch[n];
+        if (a == -1 || a == p)
+          a = p;
+        else if (b == -1 || b == p)
+          b = p;
+        else
+          b = -2;
+      }
     });
+    const std::vector<Plane> planes = flat_patches(mesh);
+    auto walled = [&](std::int32_t p) {
+      return wall && static_cast<std::size_t>(p) < on_surface.size() &&
+             on_surface[static_cast<std::size_t>(p)];
+    };
+    auto flat = [&](std::int32_t p) {
+      return !walled(p) && planes[static_cast<std::size_t>(p)].normal.squaredNorm() > 0.0;
+    };
     freedom_.assign(n_nodes, Freedom::interior);
+    plane_.assign(n_nodes, -1);
     for (std::size_t n = 0; n < n_nodes; ++n) {
-      const auto p = patch[n];
-      if (p == -2 || (p >= 0 && !(wall && static_cast<std::size_t>(p) < on_surface.size() &&
-                                  on_surface[static_cast<std::size_t>(p)])))
+      const auto [a, b] = patch[n];
+      if (a == -1) continue;
+      if (b == -1) {
+        freedom_[n] = walled(a) ? Freedom::surface : flat(a) ? Freedom::plane : Freedom::fixed;
+        if (freedom_[n] == Freedom::plane) plane_[n] = a;
+      } else if (b >= 0 && ((walled(a) && flat(b)) || (flat(a) && walled(b)))) {
+        freedom_[n] = Freedom::rim;
+        plane_[n] = walled(a) ? b : a;
+      } else {
         freedom_[n] = Freedom::fixed;
-      else if (p >= 0)
-        freedom_[n] = Freedom::surface;
+      }
     }
+    planes_ = planes;
     // The hexahedra of the interior keep their shape: a node used by hexahedra only stays.
     std::vector<char> other(n_nodes, 0);
     for (const auto& t : mesh.tets)
@@ -221,7 +292,8 @@ class Relocator {
           (*unchanged_from)[static_cast<std::size_t>(c)] = -1;
       double value;
       Vec gradient;
-      if (freedom_[n] == Freedom::surface && wall_->evaluate(mesh_.nodes[n], value, gradient))
+      if ((freedom_[n] == Freedom::surface || freedom_[n] == Freedom::rim) &&
+          wall_->evaluate(mesh_.nodes[n], value, gradient))
         stats.largest_surface_offset =
             std::max(stats.largest_surface_offset, std::abs(value) / gradient.norm());
     }
@@ -236,11 +308,14 @@ class Relocator {
   }
 
   // The lowest score of n's cells with n at p, stopping as soon as one is at or below `floor`;
-  // −∞ when a cell that meets the targets would no longer meet them.
-  double worst_around(NodeId n, const Vec& p, double floor) const {
+  // −∞ when a cell that meets the targets would no longer meet them. Cell `first` (one of n's,
+  // the worst where n stands) is scored first, since it most often ends the search.
+  double worst_around(NodeId n, const Vec& p, double floor, std::int32_t first) const {
     auto at = [&](NodeId m) -> const Vec& { return m == n ? p : mesh_.nodes[m]; };
-    double worst = INFINITY;
+    double worst = score_(cells_[static_cast<std::size_t>(first)], at);
+    if (worst <= floor) return worst;
     for (auto c : node_cells_.of(n)) {
+      if (c == first) continue;
       const double s = score_(cells_[static_cast<std::size_t>(c)], at);
       if (s < 1.0 && score_of_[static_cast<std::size_t>(c)] >= 1.0f) return -INFINITY;
       worst = std::min(worst, s);
@@ -249,7 +324,30 @@ class Relocator {
     return worst;
   }
 
-  // The boundary faces around a surface node keep their orientation (within 60°).
+  // p brought back onto where a node of this freedom may be (origin: where it stood); false when
+  // that fails or lies farther than `reach` from the step's end.
+  bool constrain(Freedom freedom, const Plane* plane, const Vec& origin, Vec& p,
+                 double reach) const {
+    if (freedom == Freedom::surface) return project(*wall_, p, reach);
+    p = plane->through(p, origin);
+    if (freedom == Freedom::plane) return true;
+    // The rim: Newton steps on the level zero along its gradient within the plane.
+    const Vec start = p;
+    for (int it = 0; it < 12; ++it) {
+      double value;
+      Vec gradient;
+      if (!wall_->evaluate(p, value, gradient)) return false;
+      gradient -= gradient.dot(plane->normal) * plane->normal;
+      const double g2 = gradient.squaredNorm();
+      if (!(g2 > 0.0)) return false;
+      const Vec step = value / g2 * gradient;
+      p = plane->through(p - step, origin);
+      if (step.norm() <= 1e-10 * reach) return (p - start).norm() <= reach;
+    }
+    return false;
+  }
+
+  // The boundary faces around a boundary node keep their orientation (within 60°).
   bool faces_keep_orientation(NodeId n, const Vec& p) const {
     for (auto f : node_faces_.of(n)) {
       const auto v = face(static_cast<std::size_t>(f));
@@ -283,17 +381,18 @@ class Relocator {
     length /= static_cast<double>(neighbours);
 
     Vec x = origin;
-    double best = worst_around(n, x, -INFINITY);
+    double best = worst_around(n, x, -INFINITY, around[0]);
     if (best >= 1.0) return false;
-    const bool surface = freedom_[n] == Freedom::surface;
+    const Freedom freedom = freedom_[n];
+    const Plane* plane = plane_[n] >= 0 ? &planes_[static_cast<std::size_t>(plane_[n])] : nullptr;
     double h = 0.25 * length;
     bool moved = false;
     for (int iteration = 0; iteration < 12 && h > 1e-3 * length; ++iteration) {
       std::array<Vec, 7> directions;
       int count = 0;
+      std::int32_t worst_cell = around[0];
       // The worst cell's score gradient, by forward differences.
       {
-        std::int32_t worst_cell = around[0];
         double worst = INFINITY;
         auto at = [&](NodeId m) -> const Vec& { return m == n ? x : mesh_.nodes[m]; };
         for (auto c : around) {
@@ -309,15 +408,30 @@ class Relocator {
           gradient[d] =
               (score_(cells_[static_cast<std::size_t>(worst_cell)], moved_at) - worst) / delta;
         }
-        if (surface) {
-          double value;
+        if (freedom == Freedom::surface || freedom == Freedom::plane) {
           Vec normal;
-          if (!wall_->evaluate(x, value, normal) || !(normal.squaredNorm() > 0.0)) return moved;
-          normal.normalize();
+          if (plane) {
+            normal = plane->normal;
+          } else {
+            double value;
+            if (!wall_->evaluate(x, value, normal) || !(normal.squaredNorm() > 0.0)) return moved;
+            normal.normalize();
+          }
           gradient -= gradient.dot(normal) * normal;
           const Vec t1 = normal.unitOrthogonal(), t2 = normal.cross(t1);
           directions = {gradient, t1, -t1, t2, -t2, Vec::Zero(), Vec::Zero()};
           count = 5;
+        } else if (freedom == Freedom::rim) {
+          // Along the line where the wall meets the plane.
+          double value;
+          Vec wall_normal;
+          if (!wall_->evaluate(x, value, wall_normal)) return moved;
+          Vec t = plane->normal.cross(wall_normal);
+          if (!(t.squaredNorm() > 0.0)) return moved;
+          t.normalize();
+          directions = {gradient.dot(t) * t, t,           -t,         Vec::Zero(),
+                        Vec::Zero(),         Vec::Zero(), Vec::Zero()};
+          count = 3;
         } else {
           directions = {gradient,      Vec::UnitX(), -Vec::UnitX(), Vec::UnitY(),
                         -Vec::UnitY(), Vec::UnitZ(), -Vec::UnitZ()};
@@ -332,8 +446,10 @@ class Relocator {
       bool improved = false;
       for (int d = 0; d < count; ++d) {
         Vec p = x + h * directions[d];
-        if (surface && (!project(*wall_, p, 2.0 * h) || !faces_keep_orientation(n, p))) continue;
-        const double s = worst_around(n, p, best);
+        if (freedom != Freedom::interior &&
+            (!constrain(freedom, plane, origin, p, 2.0 * h) || !faces_keep_orientation(n, p)))
+          continue;
+        const double s = worst_around(n, p, best, worst_cell);
         if (s > best * (1.0 + 1e-9) + 1e-12) {
           best = s;
           best_position = p;
@@ -358,6 +474,8 @@ class Relocator {
   const LevelSet* wall_;
   Scorer score_;
   std::vector<Freedom> freedom_;
+  std::vector<std::int32_t> plane_;  // the flat patch of plane and rim nodes
+  std::vector<Plane> planes_;        // of each patch
   NodeItems node_cells_, node_faces_;
   std::vector<float> score_of_;  // of every cell, as the nodes stand
 };

@@ -2,7 +2,8 @@
 // Node relocation (issue 30, item 2): after the collapses of 3.3, the nodes of tetrahedra and
 // pyramids below the quality targets move to raise the worst cell around them. Interior nodes
 // move freely, wall nodes slide on the wall's level set (they stay on the surface the mesher put
-// them on), nodes of hexahedra, of cut planes and of lines between patches stay. A move is
+// them on), nodes of flat patches (cut planes) move in their plane and along its line with the
+// wall; nodes used by hexahedra only and of other lines between patches stay. A move is
 // kept only if it raises the worst score of the node's cells, so no cell is inverted and the
 // worst quality never falls.
 #include <cstddef>
@@ -36,8 +37,10 @@ struct RelocateStats {
 };
 
 // on_surface[p]: the faces of patch p lie on `wall` (the wall and the regions cut from it); their
-// nodes slide on it. Without `wall` every boundary node stays. unchanged_from (as improve_mesh
-// gives it, one entry per cell in the mesh's order) gets −1 for every cell that moved.
+// nodes slide on it. Nodes of another patch that is flat (a cut plane, a box side) move within
+// its plane, and those on its line with the wall along that line. Without `wall` the wall's
+// nodes stay. unchanged_from (as improve_mesh gives it, one entry per cell in the mesh's order)
+// gets −1 for every cell that moved.
 RelocateStats relocate_nodes(HybridMesh& mesh, const LevelSet* wall,
                              const std::vector<bool>& on_surface, const RelocateOptions& options,
                              std::vector<std::int64_t>* unchanged_from = nullptr);

@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <set>
+#include <span>
+#include <vector>
 
 #include "core/error.h"
 #include "mesh/mve/mve.h"
@@ -87,6 +90,82 @@ TEST(Relocate, SphereSignedDistanceImprovesAndStaysOnTheSurface) {
   }
   EXPECT_GT(interior, 0u);
   EXPECT_EQ(mesh.hexes.size(), before.hexes.size());
+}
+
+// A cylinder through the image's ends: the ends become the flat patches kmin and kmax. Their
+// nodes move in their plane and the rim's along the line where the wall meets it.
+TEST(Relocate, CutPlaneNodesMoveInTheirPlaneAndTheRimOnBoth) {
+  const int n = 24;
+  const double radius = 8.3;
+  const Eigen::Vector2d axis(11.37, 11.71);
+  Volume<float> volume;
+  volume.frame.dims = {n, n, n};
+  volume.values.resize(volume.frame.voxel_count());
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        volume.at(i, j, k) = static_cast<float>(radius - (Eigen::Vector2d(i, j) - axis).norm() +
+                                                0.3 * std::sin(0.4 * k));
+  const mve::VolumeField field(volume, InsideRule::above, 0.0);
+  mve::MveOptions options;
+  options.keep_largest_component = false;
+  HybridMesh mesh = mve::march_volume_elements(field, options);
+  improve_mesh(mesh, 1.0, ImproveOptions{});
+  const int wall = mesh.patch_id("wall"), kmin = mesh.patch_id("kmin"),
+            kmax = mesh.patch_id("kmax");
+  ASSERT_GE(kmin, 0);
+  ASSERT_GE(kmax, 0);
+  // Nodes of an end off the lattice's lines (both in-plane coordinates fractional), and the
+  // ends' nodes that are also on the wall.
+  auto census = [&](const HybridMesh& m, std::size_t& off_lines, std::vector<NodeId>& rim) {
+    std::vector<int> patches(m.nodes.size(), 0);
+    for_each_boundary_face(m, [&](std::span<const NodeId> f, std::int32_t p) {
+      for (NodeId v : f) patches[v] |= p == wall ? 1 : (p == kmin || p == kmax) ? 2 : 4;
+    });
+    off_lines = 0;
+    rim.clear();
+    for (std::size_t v = 0; v < m.nodes.size(); ++v) {
+      if (!(patches[v] & 2)) continue;
+      const Eigen::Vector3d& x = m.nodes[v];
+      EXPECT_TRUE(x.z() == 0.0 || x.z() == n - 1.0) << "node " << v << " left its end: " << x.z();
+      auto fractional = [](double c) { return std::abs(c - std::round(c)) > 1e-9; };
+      off_lines += fractional(x.x()) && fractional(x.y());
+      if (patches[v] & 1) rim.push_back(static_cast<NodeId>(v));
+    }
+  };
+  std::size_t off_before = 0, off_after = 0;
+  std::vector<NodeId> rim_before, rim_after;
+  census(mesh, off_before, rim_before);
+  const HybridMesh before = mesh;
+
+  std::vector<bool> on_surface(mesh.patch_names.size(), false);
+  on_surface[static_cast<std::size_t>(wall)] = true;
+  const RelocateStats s = relocate_nodes(mesh, &field, on_surface, RelocateOptions{});
+  std::printf("[ info ] worst score %.4f → %.4f; end nodes off the lattice lines %zu → ",
+              s.worst_before, s.worst_after, off_before);
+  census(mesh, off_after, rim_after);
+  std::printf("%zu\n", off_after);
+  const MeshCheck check = check_mesh(mesh);
+  ASSERT_TRUE(check.valid()) << check.describe();
+  EXPECT_GT(s.worst_after, s.worst_before);
+  EXPECT_GT(off_after, off_before);
+  // The rim's nodes that moved are on the wall's level zero (and on their end, checked above).
+  // Those that stayed include the face points of ambiguous faces, which lie off it.
+  std::set<std::array<double, 3>> stayed;
+  for (NodeId v : rim_before)
+    stayed.insert({before.nodes[v].x(), before.nodes[v].y(), before.nodes[v].z()});
+  std::size_t rim_moved = 0;
+  for (NodeId v : rim_after) {
+    const Eigen::Vector3d& x = mesh.nodes[v];
+    if (stayed.count({x.x(), x.y(), x.z()})) continue;
+    ++rim_moved;
+    double value;
+    Eigen::Vector3d gradient;
+    ASSERT_TRUE(field.evaluate(x, value, gradient));
+    EXPECT_LT(std::abs(value) / gradient.norm(), 1e-9) << "rim node " << v;
+  }
+  std::printf("[ info ] %zu of %zu rim nodes moved\n", rim_moved, rim_after.size());
+  EXPECT_GT(rim_moved, 0u);
 }
 
 TEST(Relocate, WithoutTheImprovementIsRefused) {
