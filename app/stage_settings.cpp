@@ -104,7 +104,7 @@ MeshSettings::MeshSettings() {
       .range(0.0, 0.5);
   table.add("relocate", job.relocate,
             "after the collapses, move the nodes of cells below the quality targets (wall nodes "
-            "sliding on the surface) and remove wall slivers");
+            "sliding on the surface, cut-plane nodes in their plane) and remove wall slivers");
   table
       .add("subdivide", job.subdivisions,
            "refine N times after the improvement, each time every cell into 8 of half its size "
