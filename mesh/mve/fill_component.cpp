@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 
 namespace naris::mve {
 namespace {
@@ -10,9 +9,8 @@ namespace {
 // Cells thinner than this (6× volume, in units of the voxel) count as invalid.
 constexpr double kMinVolume6 = 1e-12;
 // A valid candidate whose worst corner Jacobian reaches this is taken without trying the others:
-// the search for a better one then changes no measured quality (docs/results/relocation.md).
-static const double kGoodShape =
-    std::getenv("NARIS_GOOD") ? std::atof(std::getenv("NARIS_GOOD")) : 0.3;
+// searching on from there changes no measured quality (docs/results/relocation.md).
+constexpr double kGoodShape = 0.3;
 
 using Points = std::array<Eigen::Vector3d, kMaxLocalPoints>;
 
@@ -224,7 +222,7 @@ void fill_component(const Component& comp, const Eigen::Vector3d& cube_min, Poin
     if (m.volume6 > best) best = m.volume6, least_bad = &cand;
   }
   if (chosen) {
-    if (chosen != placed) place_and_measure(*chosen, x);
+    if (chosen != placed) place_and_measure(*chosen, x, false);
     emit(*chosen, x, out);
     return;
   }

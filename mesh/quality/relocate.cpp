@@ -208,7 +208,7 @@ class Relocator {
     });
     const std::vector<Plane> planes = flat_patches(mesh);
     auto walled = [&](std::int32_t p) {
-      return wall && static_cast<std::size_t>(p) < on_surface.size() &&
+      return static_cast<std::size_t>(p) < on_surface.size() &&
              on_surface[static_cast<std::size_t>(p)];
     };
     auto flat = [&](std::int32_t p) {
@@ -220,9 +220,11 @@ class Relocator {
       const auto [a, b] = patch[n];
       if (a == -1) continue;
       if (b == -1) {
-        freedom_[n] = walled(a) ? Freedom::surface : flat(a) ? Freedom::plane : Freedom::fixed;
+        freedom_[n] = walled(a) ? (wall ? Freedom::surface : Freedom::fixed)
+                      : flat(a) ? Freedom::plane
+                                : Freedom::fixed;
         if (freedom_[n] == Freedom::plane) plane_[n] = a;
-      } else if (b >= 0 && ((walled(a) && flat(b)) || (flat(a) && walled(b)))) {
+      } else if (wall && b >= 0 && ((walled(a) && flat(b)) || (flat(a) && walled(b)))) {
         freedom_[n] = Freedom::rim;
         plane_[n] = walled(a) ? b : a;
       } else {
@@ -308,8 +310,8 @@ class Relocator {
   }
 
   // The lowest score of n's cells with n at p, stopping as soon as one is at or below `floor`;
-  // −∞ when a cell that meets the targets would no longer meet them. Cell `first` (one of n's,
-  // the worst where n stands) is scored first, since it most often ends the search.
+  // −∞ when a cell that meets the targets would no longer meet them. Cell `first` (one of n's)
+  // is scored first: the worst where n stands most often ends the search.
   double worst_around(NodeId n, const Vec& p, double floor, std::int32_t first) const {
     auto at = [&](NodeId m) -> const Vec& { return m == n ? p : mesh_.nodes[m]; };
     double worst = score_(cells_[static_cast<std::size_t>(first)], at);
@@ -450,7 +452,7 @@ class Relocator {
             (!constrain(freedom, plane, origin, p, 2.0 * h) || !faces_keep_orientation(n, p)))
           continue;
         const double s = worst_around(n, p, best, worst_cell);
-        if (s > best * (1.0 + 1e-9) + 1e-12) {
+        if (s > best + 1e-9 * std::abs(best) + 1e-12) {
           best = s;
           best_position = p;
           improved = true;

@@ -115,8 +115,8 @@ TEST(Relocate, CutPlaneNodesMoveInTheirPlaneAndTheRimOnBoth) {
             kmax = mesh.patch_id("kmax");
   ASSERT_GE(kmin, 0);
   ASSERT_GE(kmax, 0);
-  // Nodes of an end off the lattice's lines (both in-plane coordinates fractional), and the
-  // ends' nodes that are also on the wall.
+  // Nodes of an end alone (not on the wall) off the lattice's lines (both in-plane coordinates
+  // fractional), and the ends' nodes that are also on the wall.
   auto census = [&](const HybridMesh& m, std::size_t& off_lines, std::vector<NodeId>& rim) {
     std::vector<int> patches(m.nodes.size(), 0);
     for_each_boundary_face(m, [&](std::span<const NodeId> f, std::int32_t p) {
@@ -129,7 +129,7 @@ TEST(Relocate, CutPlaneNodesMoveInTheirPlaneAndTheRimOnBoth) {
       const Eigen::Vector3d& x = m.nodes[v];
       EXPECT_TRUE(x.z() == 0.0 || x.z() == n - 1.0) << "node " << v << " left its end: " << x.z();
       auto fractional = [](double c) { return std::abs(c - std::round(c)) > 1e-9; };
-      off_lines += fractional(x.x()) && fractional(x.y());
+      off_lines += patches[v] == 2 && fractional(x.x()) && fractional(x.y());
       if (patches[v] & 1) rim.push_back(static_cast<NodeId>(v));
     }
   };
