@@ -346,6 +346,7 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
         {"nodes_moved", r.relocation.nodes_moved},
         {"moves", r.relocation.moves},
         {"slivers_removed", r.relocation.slivers_removed},
+        {"edges_removed", r.relocation.edges_removed},
         {"largest_surface_offset_mm", significant(r.relocation.largest_surface_offset)},
         {"seconds", significant(r.relocation.seconds, 5)}};
   write_json_file(sibling("mesh.json"), json);
@@ -400,10 +401,11 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
         r.improvement.removed_cells, r.improvement.pyramids_to_tets);
   if (job.relocate)
     s += fmt::format(
-        "  relocated {} nodes, removed {} wall slivers: cells below target {} → {}, worst score "
-        "{:.3f} → {:.3f}\n",
-        r.relocation.nodes_moved, r.relocation.slivers_removed, r.relocation.cells_below_before,
-        r.relocation.cells_below_after, r.relocation.worst_before, r.relocation.worst_after);
+        "  relocated {} nodes, removed {} edges and {} wall slivers: cells below target {} → {}, "
+        "worst score {:.3f} → {:.3f}\n",
+        r.relocation.nodes_moved, r.relocation.edges_removed, r.relocation.slivers_removed,
+        r.relocation.cells_below_before, r.relocation.cells_below_after, r.relocation.worst_before,
+        r.relocation.worst_after);
   if (job.subdivisions > 0)
     s += fmt::format("  subdivided {}× (same geometry): {} → {} cells\n", job.subdivisions,
                      r.cells_before_subdivision, m.cell_count());

@@ -650,6 +650,178 @@ std::size_t remove_boundary_slivers(HybridMesh& mesh, const std::vector<bool>& o
 }
 
 // How many cells are below target, and the lowest score.
+// The triangulations of a convex polygon with corners 0 … m−1 (m ≤ kMaxRing), as lists of
+// corner triples in the polygon's order.
+constexpr int kMaxRing = 7;
+using Triangulation = std::vector<std::array<int, 3>>;
+void triangulate(int first, int last, Triangulation& partial, std::vector<Triangulation>& all,
+                 std::vector<std::pair<int, int>>& pending) {
+  if (last - first < 2) {
+    if (pending.empty()) {
+      all.push_back(partial);
+      return;
+    }
+    const auto [f, l] = pending.back();
+    pending.pop_back();
+    triangulate(f, l, partial, all, pending);
+    pending.push_back({f, l});
+    return;
+  }
+  for (int k = first + 1; k < last; ++k) {
+    partial.push_back({first, k, last});
+    pending.push_back({k, last});
+    triangulate(first, k, partial, all, pending);
+    pending.pop_back();
+    partial.pop_back();
+  }
+}
+const std::vector<Triangulation>& triangulations(int m) {
+  static const auto table = [] {
+    std::array<std::vector<Triangulation>, kMaxRing + 1> t;
+    for (int size = 3; size <= kMaxRing; ++size) {
+      Triangulation partial;
+      std::vector<std::pair<int, int>> pending;
+      triangulate(0, size - 1, partial, t[static_cast<std::size_t>(size)], pending);
+    }
+    return t;
+  }();
+  return table[static_cast<std::size_t>(m)];
+}
+
+// Edge removal (Shewchuk 2002): the m tetrahedra around an interior edge u–v whose cells are all
+// tetrahedra (3 ≤ m ≤ 7) become 2(m − 2): the ring of their other nodes triangulated, each
+// triangle joined to u and to v. Taken for an edge of a tetrahedron below target when every new
+// cell is positive and the worst of them scores better than the worst of the old; the best
+// triangulation and the best edge of the cell win. The union, and so every boundary face, is
+// unchanged. One sweep; cells changed once are not changed again.
+std::size_t remove_edges(HybridMesh& mesh, const Scorer& score,
+                         std::vector<std::int64_t>* unchanged_from) {
+  using Tet = std::array<NodeId, 4>;
+  auto at = [&](NodeId n) -> const Vec& { return mesh.nodes[n]; };
+  auto tet_score = [&](const Tet& t) { return score(std::span<const NodeId>(t), at); };
+  const std::size_t n_tets = mesh.tets.size();
+  std::vector<std::size_t> candidates;
+  for (std::size_t c = 0; c < n_tets; ++c)
+    if (tet_score(mesh.tets[c]) < 1.0) candidates.push_back(c);
+  if (candidates.empty()) return 0;
+  NodeItems node_tets;
+  node_tets.build(mesh.nodes.size(), n_tets, [&](std::size_t c) { return mesh.tets[c]; });
+
+  std::vector<char> touched(n_tets, 0), gone(n_tets, 0);
+  std::vector<Tet> fresh_best, fresh;
+  std::vector<std::int32_t> ring_best, ring_cells;
+  std::array<NodeId, kMaxRing> ring{};
+  std::size_t removals = 0;
+  for (std::size_t c : candidates) {
+    if (touched[c]) continue;
+    const Tet t = mesh.tets[c];
+    double best_gain = 0.0;
+    fresh_best.clear();
+    ring_best.clear();
+    for (int e = 0; e < 6; ++e) {
+      const NodeId u = t[kTetEdges[e][0]], v = t[kTetEdges[e][1]];
+      // The tetrahedra around u–v, each giving the ring a directed edge x → y with (u, v, x, y)
+      // positive. Around a boundary edge, or one a pyramid or hexahedron shares, they leave a
+      // gap and the ring does not close.
+      ring_cells.clear();
+      std::array<std::pair<NodeId, NodeId>, kMaxRing> links{};
+      bool usable = true;
+      for (auto k : node_tets.of(u)) {
+        const Tet& w = mesh.tets[static_cast<std::size_t>(k)];
+        if (std::find(w.begin(), w.end(), v) == w.end()) continue;
+        if (touched[static_cast<std::size_t>(k)] || ring_cells.size() == kMaxRing) {
+          usable = false;
+          break;
+        }
+        std::array<NodeId, 2> other{};
+        int n_other = 0;
+        for (NodeId x : w)
+          if (x != u && x != v) other[n_other++] = x;
+        if (tet_volume(at(u), at(v), at(other[0]), at(other[1])) < 0.0)
+          std::swap(other[0], other[1]);
+        links[ring_cells.size()] = {other[0], other[1]};
+        ring_cells.push_back(k);
+      }
+      const int m = static_cast<int>(ring_cells.size());
+      if (!usable || m < 3) continue;
+      // Chain the links into one closed ring of m nodes.
+      ring[0] = links[0].first;
+      bool closed = true;
+      for (int i = 1; i <= m && closed; ++i) {
+        const NodeId from = ring[static_cast<std::size_t>(i - 1)];
+        int next = -1;
+        for (int j = 0; j < m; ++j)
+          if (links[static_cast<std::size_t>(j)].first == from) next = j;
+        if (next < 0) {
+          closed = false;
+          break;
+        }
+        const NodeId to = links[static_cast<std::size_t>(next)].second;
+        if (i == m)
+          closed = to == ring[0];
+        else
+          ring[static_cast<std::size_t>(i)] = to;
+      }
+      if (!closed) continue;
+      double worst_old = INFINITY;
+      for (auto k : ring_cells) worst_old = std::min(worst_old, tet_score(mesh.tets[k]));
+      for (const auto& tri : triangulations(m)) {
+        fresh.clear();
+        double worst_new = INFINITY;
+        for (const auto& [i, j, k] : tri) {
+          const NodeId a = ring[static_cast<std::size_t>(i)], b = ring[static_cast<std::size_t>(j)],
+                       d = ring[static_cast<std::size_t>(k)];
+          // The ring runs counterclockwise seen from v ((u, v, x, y) positive), so the triangle
+          // (a, b, d) faces v: (a, b, d, v) and (d, b, a, u) are positive.
+          fresh.push_back({a, b, d, v});
+          fresh.push_back({d, b, a, u});
+        }
+        for (const Tet& n : fresh) {
+          worst_new = std::min(worst_new, tet_score(n));
+          if (!(worst_new - worst_old > best_gain)) break;
+        }
+        if (worst_new - worst_old > best_gain) {
+          best_gain = worst_new - worst_old;
+          fresh_best = fresh;
+          ring_best = ring_cells;
+        }
+      }
+    }
+    if (fresh_best.empty()) continue;
+    std::size_t next = 0;
+    for (auto k : ring_best) {
+      const auto slot = static_cast<std::size_t>(k);
+      touched[slot] = 1;
+      if (next < fresh_best.size())
+        mesh.tets[slot] = fresh_best[next++];
+      else
+        gone[slot] = 1;
+    }
+    for (; next < fresh_best.size(); ++next) {
+      mesh.tets.push_back(fresh_best[next]);
+      touched.push_back(1);
+      gone.push_back(0);
+    }
+    ++removals;
+  }
+  if (removals == 0) return 0;
+  // Removed slots leave; every changed or new tetrahedron is "changed" for the quality report.
+  std::vector<std::int64_t> from;
+  std::size_t kept = 0;
+  for (std::size_t c = 0; c < mesh.tets.size(); ++c) {
+    if (gone[c]) continue;
+    if (unchanged_from) from.push_back(touched[c] ? -1 : (*unchanged_from)[c]);
+    mesh.tets[kept++] = mesh.tets[c];
+  }
+  mesh.tets.resize(kept);
+  if (unchanged_from) {
+    from.insert(from.end(), unchanged_from->begin() + static_cast<std::ptrdiff_t>(n_tets),
+                unchanged_from->end());
+    *unchanged_from = std::move(from);
+  }
+  return removals;
+}
+
 void summarize(const HybridMesh& mesh, const Scorer& score, std::size_t& below, double& worst) {
   const Cells cells{mesh};
   auto at = [&](NodeId n) -> const Vec& { return mesh.nodes[n]; };
@@ -675,6 +847,7 @@ RelocateStats relocate_nodes(HybridMesh& mesh, const LevelSet* wall,
   std::size_t removed = remove_boundary_slivers(mesh, on_surface, score, unchanged_from);
   RelocateStats stats =
       Relocator(mesh, wall, on_surface, options).run(options.sweeps, unchanged_from);
+  stats.edges_removed = remove_edges(mesh, score, unchanged_from);
   removed += remove_boundary_slivers(mesh, on_surface, score, unchanged_from);
   stats.slivers_removed = removed;
   stats.cells_below_before = below_before;

@@ -30,6 +30,7 @@ struct RelocateStats {
   std::size_t nodes_moved = 0;  // distinct nodes
   std::size_t moves = 0;
   std::size_t slivers_removed = 0;  // wall tetrahedra that no move could lift
+  std::size_t edges_removed = 0;    // interior edges of cells below target, removed by flips
   double worst_before = 0.0;        // lowest score
   double worst_after = 0.0;
   double largest_surface_offset = 0.0;  // mm: |level set| / |gradient| at moved wall nodes
