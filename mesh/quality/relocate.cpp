@@ -649,7 +649,6 @@ std::size_t remove_boundary_slivers(HybridMesh& mesh, const std::vector<bool>& o
   return removed;
 }
 
-// How many cells are below target, and the lowest score.
 // The triangulations of a convex polygon with corners 0 … m−1 (m ≤ kMaxRing), as lists of
 // corner triples in the polygon's order.
 constexpr int kMaxRing = 7;
@@ -729,7 +728,10 @@ std::size_t remove_edges(HybridMesh& mesh, const Scorer& score,
       for (auto k : node_tets.of(u)) {
         const Tet& w = mesh.tets[static_cast<std::size_t>(k)];
         if (std::find(w.begin(), w.end(), v) == w.end()) continue;
-        if (touched[static_cast<std::size_t>(k)] || ring_cells.size() == kMaxRing) {
+        // The ring's direction comes from the cells' volumes, so an inverted or flat one
+        // (which could reverse it) keeps the edge.
+        if (touched[static_cast<std::size_t>(k)] || ring_cells.size() == kMaxRing ||
+            !(tet_volume(at(w[0]), at(w[1]), at(w[2]), at(w[3])) > 0.0)) {
           usable = false;
           break;
         }
@@ -822,6 +824,7 @@ std::size_t remove_edges(HybridMesh& mesh, const Scorer& score,
   return removals;
 }
 
+// How many cells are below target, and the lowest score.
 void summarize(const HybridMesh& mesh, const Scorer& score, std::size_t& below, double& worst) {
   const Cells cells{mesh};
   auto at = [&](NodeId n) -> const Vec& { return mesh.nodes[n]; };

@@ -142,8 +142,9 @@ TEST(Relocate, CutPlaneNodesMoveInTheirPlaneAndTheRimOnBoth) {
   std::vector<bool> on_surface(mesh.patch_names.size(), false);
   on_surface[static_cast<std::size_t>(wall)] = true;
   const RelocateStats s = relocate_nodes(mesh, &field, on_surface, RelocateOptions{});
-  std::printf("[ info ] edges %zu worst score %.4f → %.4f; end nodes off the lattice lines %zu → ",
-              s.edges_removed, s.worst_before, s.worst_after, off_before);
+  std::printf(
+      "[ info ] %zu edges removed; worst score %.4f → %.4f; end nodes off the lattice lines %zu → ",
+      s.edges_removed, s.worst_before, s.worst_after, off_before);
   census(mesh, off_after, rim_after);
   std::printf("%zu\n", off_after);
   const MeshCheck check = check_mesh(mesh);
