@@ -37,6 +37,18 @@ inline double boundary_volume(const HybridMesh& m) {
   return v;
 }
 
+// A volume of nx × ny × nz voxels (unit spacing, origin 0) holding value(i, j, k).
+template <class T, class F>
+Volume<T> sampled_volume(int nx, int ny, int nz, F&& value) {
+  Volume<T> v;
+  v.frame.dims = {nx, ny, nz};
+  v.values.resize(v.frame.voxel_count());
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) v.at(i, j, k) = static_cast<T>(value(i, j, k));
+  return v;
+}
+
 inline mve::MveOptions quiet_options() {
   mve::MveOptions o;
   o.keep_largest_component = false;

@@ -15,28 +15,29 @@
 #include "mesh/quality/check.h"
 #include "mesh/quality/improve.h"
 #include "mesh/quality/relocate.h"
+#include "tests/mesh/field_helpers.h"
 
 namespace naris {
 namespace {
+
+// MVE's mesh of the field after the collapses of 3.3 (relocation's input).
+HybridMesh collapsed_mesh(const mve::VolumeField& field,
+                          std::vector<std::int64_t>* unchanged_from = nullptr) {
+  HybridMesh mesh = mve::march_volume_elements(field, testing::quiet_options());
+  improve_mesh(mesh, 1.0, ImproveOptions{}, unchanged_from);
+  return mesh;
+}
 
 TEST(Relocate, SphereSignedDistanceImprovesAndStaysOnTheSurface) {
   const int n = 30;
   const double radius = 11.3;
   const Eigen::Vector3d centre(14.37, 14.71, 14.13);
-  Volume<float> volume;
-  volume.frame.dims = {n, n, n};
-  volume.values.resize(volume.frame.voxel_count());
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        volume.at(i, j, k) =
-            static_cast<float>(radius - (Eigen::Vector3d(i, j, k) - centre).norm());
+  const auto volume = testing::sampled_volume<float>(n, n, n, [&](int i, int j, int k) {
+    return radius - (Eigen::Vector3d(i, j, k) - centre).norm();
+  });
   const mve::VolumeField field(volume, InsideRule::above, 0.0);
-  mve::MveOptions options;
-  options.keep_largest_component = false;
-  HybridMesh mesh = mve::march_volume_elements(field, options);
   std::vector<std::int64_t> unchanged_from;
-  improve_mesh(mesh, 1.0, ImproveOptions{}, &unchanged_from);
+  HybridMesh mesh = collapsed_mesh(field, &unchanged_from);
   const HybridMesh before = mesh;
   auto farthest_wall_node = [&](const HybridMesh& m) {
     double d = 0.0;
@@ -99,19 +100,11 @@ TEST(Relocate, CutPlaneNodesMoveInTheirPlaneAndTheRimOnBoth) {
   const int n = 24;
   const double radius = 8.3;
   const Eigen::Vector2d axis(11.37, 11.71);
-  Volume<float> volume;
-  volume.frame.dims = {n, n, n};
-  volume.values.resize(volume.frame.voxel_count());
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        volume.at(i, j, k) = static_cast<float>(radius - (Eigen::Vector2d(i, j) - axis).norm() +
-                                                0.3 * std::sin(0.4 * k));
+  const auto volume = testing::sampled_volume<float>(n, n, n, [&](int i, int j, int k) {
+    return radius - (Eigen::Vector2d(i, j) - axis).norm() + 0.3 * std::sin(0.4 * k);
+  });
   const mve::VolumeField field(volume, InsideRule::above, 0.0);
-  mve::MveOptions options;
-  options.keep_largest_component = false;
-  HybridMesh mesh = mve::march_volume_elements(field, options);
-  improve_mesh(mesh, 1.0, ImproveOptions{});
+  HybridMesh mesh = collapsed_mesh(field);
   const int wall = mesh.patch_id("wall"), kmin = mesh.patch_id("kmin"),
             kmax = mesh.patch_id("kmax");
   ASSERT_GE(kmin, 0);

@@ -17,13 +17,8 @@ namespace naris {
 namespace {
 
 Volume<std::uint8_t> sampled(int nx, int ny, int nz, auto&& inside) {
-  Volume<std::uint8_t> v;
-  v.frame.dims = {nx, ny, nz};
-  v.values.resize(v.frame.voxel_count());
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) v.at(i, j, k) = inside(i, j, k) ? 1 : 0;
-  return v;
+  return testing::sampled_volume<std::uint8_t>(
+      nx, ny, nz, [&](int i, int j, int k) { return inside(i, j, k) ? 1 : 0; });
 }
 
 struct Meshed {
