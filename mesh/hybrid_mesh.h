@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/big_vector.h"
@@ -96,6 +97,13 @@ void for_each_boundary_face(const HybridMesh& m, F&& f) {
     f(std::span<const NodeId>(m.boundary_tris[i]), m.boundary_tri_patch[i]);
   for (std::size_t i = 0; i < m.boundary_quads.size(); ++i)
     f(std::span<const NodeId>(m.boundary_quads[i]), m.boundary_quad_patch[i]);
+}
+
+// A key for the undirected edge a–b (the same for b–a).
+inline std::uint64_t edge_key(NodeId a, NodeId b) {
+  if (a > b) std::swap(a, b);
+  return static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32 |
+         static_cast<std::uint32_t>(b);
 }
 
 // Vector area ½ Σ xᵢ × xᵢ₊₁ of a polygon (along its right-hand normal); for a planar polygon

@@ -17,17 +17,36 @@ VolumeField::VolumeField(const Volume<float>& volume, InsideRule rule, double le
       level_(static_cast<float>(level)),
       to_index_(volume.frame.index_to_physical().inverse()) {}
 
-float VolumeField::value(std::size_t voxel) const {
-  const float v = volume_.values[voxel];
-  switch (rule_) {
+namespace {
+
+// A voxel's value as the field has it: positive inside. Labels become ±1, so that isopoints lie
+// halfway between voxel centres, as for any binary mask.
+template <InsideRule rule>
+float field_value(float v, float level) {
+  if constexpr (rule == InsideRule::above) return v - level;
+  if constexpr (rule == InsideRule::below) return level - v;
+  return v == level ? 1.0f : -1.0f;
+}
+
+// f(values) with the rule as a compile-time constant, so loops over voxels test it once.
+template <class F>
+void with_rule(InsideRule rule, float level, F&& f) {
+  switch (rule) {
     case InsideRule::above:
-      return v - level_;
+      return f([level](float v) { return field_value<InsideRule::above>(v, level); });
     case InsideRule::below:
-      return level_ - v;
+      return f([level](float v) { return field_value<InsideRule::below>(v, level); });
     case InsideRule::label:
-      break;
+      return f([level](float v) { return field_value<InsideRule::label>(v, level); });
   }
-  return v == level_ ? 1.0f : -1.0f;
+}
+
+}  // namespace
+
+float VolumeField::value(std::size_t voxel) const {
+  float out = 0.0f;
+  with_rule(rule_, level_, [&](auto value_of) { out = value_of(volume_.values[voxel]); });
+  return out;
 }
 
 bool VolumeField::evaluate(const Eigen::Vector3d& x, double& value_at,
@@ -68,17 +87,9 @@ bool VolumeField::evaluate(const Eigen::Vector3d& x, double& value_at,
 
 void VolumeField::read_slice(int k, std::span<float> out) const {
   const auto in = volume_.slice(k);
-  switch (rule_) {
-    case InsideRule::above:
-      for (std::size_t n = 0; n < in.size(); ++n) out[n] = in[n] - level_;
-      break;
-    case InsideRule::below:
-      for (std::size_t n = 0; n < in.size(); ++n) out[n] = level_ - in[n];
-      break;
-    case InsideRule::label:  // isopoints halfway between voxel centres, as for any binary mask
-      for (std::size_t n = 0; n < in.size(); ++n) out[n] = in[n] == level_ ? 1.0f : -1.0f;
-      break;
-  }
+  with_rule(rule_, level_, [&](auto value_of) {
+    for (std::size_t n = 0; n < in.size(); ++n) out[n] = value_of(in[n]);
+  });
 }
 
 namespace {

@@ -230,11 +230,8 @@ std::vector<PatchReport> patch_report(const HybridMesh& mesh) {
   for_each_boundary_face(mesh, [&](std::span<const NodeId> face, std::int32_t patch) {
     report[patch].faces++;
     report[patch].area += polygon_area(mesh, face);
-    for (std::size_t e = 0; e < face.size(); ++e) {
-      const auto a = static_cast<std::uint32_t>(face[e]),
-                 b = static_cast<std::uint32_t>(face[(e + 1) % face.size()]);
-      edges[patch].push_back(std::uint64_t{std::min(a, b)} << 32 | std::max(a, b));
-    }
+    for (std::size_t e = 0; e < face.size(); ++e)
+      edges[patch].push_back(edge_key(face[e], face[(e + 1) % face.size()]));
   });
   // A patch's perimeter: the edges that only one of its own faces uses.
   for (std::size_t p = 0; p < report.size(); ++p) {

@@ -225,7 +225,8 @@ MeshJobResult run_mesh_job(const MeshJob& job) {
     std::vector<std::int64_t> unchanged_from;
     r.improvement =
         improve_mesh(r.mesh, volume.frame.spacing.minCoeff(), job.improve_options, &unchanged_from);
-    // Wall nodes slide on the field's level zero; those of the cut planes and the box sides stay.
+    // Wall nodes slide on the field's level zero; the cut planes and the box sides are flat
+    // patches, whose nodes relocation keeps in their planes.
     if (job.relocate) {
       std::vector<bool> on_surface(r.mesh.patch_names.size(), true);
       for (std::size_t p = 0; p < on_surface.size(); ++p) {

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <numbers>
 #include <numeric>
+#include <span>
 #include <unordered_map>
 
 #include "core/log.h"
+#include "mesh/quality/node_incidence.h"
 
 namespace naris {
 namespace {
@@ -29,19 +31,13 @@ class Incidence {
  public:
   template <class Items>
   void build(std::size_t nodes, const Items& items) {
-    start_.assign(nodes + 1, 0);
-    for (const auto& it : items)
-      for (int k = 0; k < it.size; ++k) ++start_[static_cast<std::size_t>(it.v[k]) + 1];
-    for (std::size_t n = 0; n < nodes; ++n) start_[n + 1] += start_[n];
-    list_.resize(start_[nodes]);
-    std::vector<std::size_t> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t i = 0; i < items.size(); ++i)
-      for (int k = 0; k < items[i].size; ++k)
-        list_[fill[items[i].v[k]]++] = static_cast<std::int32_t>(i);
+    table_.build(nodes, items.size(), [&](std::size_t i) {
+      return std::span<const NodeId>(items[i].v.data(), items[i].size);
+    });
   }
   template <class F>
   void for_each(NodeId n, F&& f) const {
-    for (std::size_t i = start_[n]; i < start_[static_cast<std::size_t>(n) + 1]; ++i) f(list_[i]);
+    for (auto i : table_.of(n)) f(i);
     if (const auto it = extra_.find(n); it != extra_.end())
       for (auto i : it->second) f(i);
   }
@@ -51,8 +47,7 @@ class Incidence {
   }
 
  private:
-  std::vector<std::size_t> start_;
-  std::vector<std::int32_t> list_;
+  NodeIncidence table_;
   std::unordered_map<NodeId, std::vector<std::int32_t>> extra_;
 };
 

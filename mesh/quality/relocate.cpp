@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "core/log.h"
+#include "mesh/quality/node_incidence.h"
 
 namespace naris {
 namespace {
@@ -39,26 +40,6 @@ struct Cells {
     c -= mesh.tets.size();
     if (c < mesh.pyramids.size()) return mesh.pyramids[c];
     return mesh.hexes[c - mesh.pyramids.size()];
-  }
-};
-
-// node → items, compressed rows.
-struct NodeItems {
-  std::vector<std::size_t> start;
-  std::vector<std::int32_t> item;
-  template <class Nodes>
-  void build(std::size_t nodes, std::size_t items, const Nodes& nodes_of) {
-    start.assign(nodes + 1, 0);
-    for (std::size_t i = 0; i < items; ++i)
-      for (NodeId n : nodes_of(i)) ++start[static_cast<std::size_t>(n) + 1];
-    for (std::size_t n = 0; n < nodes; ++n) start[n + 1] += start[n];
-    item.resize(start[nodes]);
-    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < items; ++i)
-      for (NodeId n : nodes_of(i)) item[fill[n]++] = static_cast<std::int32_t>(i);
-  }
-  std::span<const std::int32_t> of(NodeId n) const {
-    return {item.data() + start[n], start[static_cast<std::size_t>(n) + 1] - start[n]};
   }
 };
 
@@ -136,18 +117,22 @@ class Scorer {
   double dihedral_, jacobian_, ratio_;
 };
 
-// Moves p onto the level zero by Newton steps along the gradient; false when it leaves the
-// function's domain, does not settle, or ends farther than `reach` from where it started.
-bool project(const LevelSet& wall, Vec& p, double reach) {
+// Moves p onto the level zero by Newton steps along the gradient, or with `plane` along the
+// gradient's part in it, p kept on the plane through `on`; false when it leaves the function's
+// domain, does not settle, or ends farther than `reach` from where it started.
+bool project(const LevelSet& wall, Vec& p, double reach, const Plane* plane = nullptr,
+             const Vec& on = Vec::Zero()) {
   const Vec start = p;
   for (int it = 0; it < 12; ++it) {
     double value;
     Vec gradient;
     if (!wall.evaluate(p, value, gradient)) return false;
+    if (plane) gradient -= gradient.dot(plane->normal) * plane->normal;
     const double g2 = gradient.squaredNorm();
     if (!(g2 > 0.0)) return false;
     const Vec step = value / g2 * gradient;
     p -= step;
+    if (plane) p = plane->through(p, on);
     if (step.norm() <= 1e-10 * reach) return (p - start).norm() <= reach;
   }
   return false;
@@ -160,11 +145,8 @@ std::vector<Plane> flat_patches(const HybridMesh& mesh) {
   std::vector<Vec> area(n_patches, Vec::Zero()), centre(n_patches, Vec::Zero());
   std::vector<double> weight(n_patches, 0.0);
   for_each_boundary_face(mesh, [&](std::span<const NodeId> f, std::int32_t p) {
-    const auto& x = mesh.nodes;
-    const Vec a = f.size() == 3 ? Vec((x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]))
-                                : Vec((x[f[2]] - x[f[0]]).cross(x[f[3]] - x[f[1]]));
-    area[p] += a;
-    for (NodeId n : f) centre[p] += x[n], weight[p] += 1.0;
+    area[p] += polygon_vector_area(mesh, f);
+    for (NodeId n : f) centre[p] += mesh.nodes[n], weight[p] += 1.0;
   });
   std::vector<Plane> planes(n_patches);
   for (std::size_t p = 0; p < n_patches; ++p) {
@@ -332,33 +314,19 @@ class Relocator {
                  double reach) const {
     if (freedom == Freedom::surface) return project(*wall_, p, reach);
     p = plane->through(p, origin);
-    if (freedom == Freedom::plane) return true;
-    // The rim: Newton steps on the level zero along its gradient within the plane.
-    const Vec start = p;
-    for (int it = 0; it < 12; ++it) {
-      double value;
-      Vec gradient;
-      if (!wall_->evaluate(p, value, gradient)) return false;
-      gradient -= gradient.dot(plane->normal) * plane->normal;
-      const double g2 = gradient.squaredNorm();
-      if (!(g2 > 0.0)) return false;
-      const Vec step = value / g2 * gradient;
-      p = plane->through(p - step, origin);
-      if (step.norm() <= 1e-10 * reach) return (p - start).norm() <= reach;
-    }
-    return false;
+    return freedom == Freedom::plane || project(*wall_, p, reach, plane, origin);
   }
 
-  // The boundary faces around a boundary node keep their orientation (within 60°).
+  // The boundary faces around a boundary node keep their orientation (within 60°). A face's
+  // vector area is linear in each corner: moving corner i by d adds ½ d × (x[i+1] − x[i−1]).
   bool faces_keep_orientation(NodeId n, const Vec& p) const {
+    const auto& x = mesh_.nodes;
     for (auto f : node_faces_.of(n)) {
       const auto v = face(static_cast<std::size_t>(f));
-      auto normal = [&](auto&& at) {
-        if (v.size() == 3) return Vec((at(v[1]) - at(v[0])).cross(at(v[2]) - at(v[0])));
-        return Vec((at(v[2]) - at(v[0])).cross(at(v[3]) - at(v[1])));
-      };
-      const Vec before = normal([&](NodeId m) -> const Vec& { return mesh_.nodes[m]; });
-      const Vec after = normal([&](NodeId m) -> const Vec& { return m == n ? p : mesh_.nodes[m]; });
+      const std::size_t i = static_cast<std::size_t>(std::find(v.begin(), v.end(), n) - v.begin());
+      const Vec before = polygon_vector_area(mesh_, v);
+      const Vec after = before + 0.5 * (p - x[n]).cross(x[v[(i + 1) % v.size()]] -
+                                                        x[v[(i + v.size() - 1) % v.size()]]);
       if (!(after.dot(before) > 0.5 * after.norm() * before.norm())) return false;
     }
     return true;
@@ -478,7 +446,7 @@ class Relocator {
   std::vector<Freedom> freedom_;
   std::vector<std::int32_t> plane_;  // the flat patch of plane and rim nodes
   std::vector<Plane> planes_;        // of each patch
-  NodeItems node_cells_, node_faces_;
+  NodeIncidence node_cells_, node_faces_;
   std::vector<float> score_of_;  // of every cell, as the nodes stand
 };
 
@@ -501,10 +469,6 @@ std::size_t remove_boundary_slivers(HybridMesh& mesh, const std::vector<bool>& o
              (static_cast<std::size_t>(k[1]) * 0xC2B2AE3D27D4EB4Full) ^
              static_cast<std::size_t>(k[2]);
     }
-  };
-  auto edge_key = [](NodeId a, NodeId b) {
-    return static_cast<std::uint64_t>(std::min(a, b)) << 32 |
-           static_cast<std::uint32_t>(std::max(a, b));
   };
   // Only tetrahedra below target whose nodes are all on the boundary are candidates; find them
   // before building any table.
@@ -703,7 +667,7 @@ std::size_t remove_edges(HybridMesh& mesh, const Scorer& score,
   for (std::size_t c = 0; c < n_tets; ++c)
     if (tet_score(mesh.tets[c]) < 1.0) candidates.push_back(c);
   if (candidates.empty()) return 0;
-  NodeItems node_tets;
+  NodeIncidence node_tets;
   node_tets.build(mesh.nodes.size(), n_tets, [&](std::size_t c) { return mesh.tets[c]; });
 
   std::vector<char> touched(n_tets, 0), gone(n_tets, 0);

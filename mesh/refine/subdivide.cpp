@@ -10,12 +10,6 @@ namespace naris {
 
 namespace {
 
-std::uint64_t edge_key(NodeId a, NodeId b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
-         static_cast<std::uint32_t>(b);
-}
-
 using QuadKey = std::array<NodeId, 4>;
 QuadKey quad_key(NodeId a, NodeId b, NodeId c, NodeId d) {
   QuadKey k = {a, b, c, d};
