@@ -2,9 +2,12 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cstring>
 #include <map>
+#include <mutex>
 #include <numeric>
 #include <random>
+#include <unordered_map>
 
 #include "core/error.h"
 #include "mesh/mve/fill_component.h"
@@ -109,22 +112,29 @@ struct UnionFind {
   void unite(int a, int b) { parent[find(a)] = find(b); }
 };
 
-std::vector<int> faces_touching(int x) {
-  std::vector<int> faces;
-  for (int f = 0; f < 6; ++f) {
-    const auto& c = kFace[f];
-    const bool on = [&] {
-      if (x < kEdgePoint0) return std::find(c.begin(), c.end(), x) != c.end();
-      if (x < kFacePoint0) {
-        const auto& e = kEdge[x - kEdgePoint0];
-        return std::find(c.begin(), c.end(), e[0]) != c.end() &&
-               std::find(c.begin(), c.end(), e[1]) != c.end();
+// Bit f is set when cube point x (a vertex, edge point or face point) lies on face f.
+std::uint8_t faces_touching(int x) {
+  static const auto masks = [] {
+    std::array<std::uint8_t, kPrivatePoint0> m{};
+    for (int f = 0; f < 6; ++f) {
+      const auto& c = kFace[f];
+      auto on = [&](int v) { return std::find(c.begin(), c.end(), v) != c.end(); };
+      for (int y = 0; y < kPrivatePoint0; ++y) {
+        const bool touches = y < kEdgePoint0 ? on(y)
+                             : y < kFacePoint0
+                                 ? on(kEdge[y - kEdgePoint0][0]) && on(kEdge[y - kEdgePoint0][1])
+                                 : y - kFacePoint0 == f;
+        if (touches) m[y] |= static_cast<std::uint8_t>(1u << f);
       }
-      return x - kFacePoint0 == f;
-    }();
-    if (on) faces.push_back(f);
-  }
-  return faces;
+    }
+    return m;
+  }();
+  return x < kPrivatePoint0 ? masks[x] : 0;
+}
+
+// A triangle of cube points that lies on one cube face.
+bool on_one_cube_face(const Polygon& t) {
+  return (faces_touching(t.p[0]) & faces_touching(t.p[1]) & faces_touching(t.p[2])) != 0;
 }
 
 // Random placements of the isopoints, including extreme ones, used to decide which
@@ -163,6 +173,11 @@ void sample_points(const CaseEntry& entry, const std::array<double, 12>& t, Poin
 }
 
 constexpr int kFanFromApex = -2;
+// Ways of fanning a component's isosurface loops tried by the fewest-cell search.
+constexpr int kMaxLoopFans = 12;
+// Candidates kept per component: single-apex fills (the most robust first), then multi-apex.
+constexpr std::size_t kSingleApexKept = 6;
+constexpr std::size_t kMultiApexKept = 2;
 
 // Cone from apex x over every boundary polygon of the component that does not contain it.
 // Returns false when x lies on a cube face whose polygons are not a fan from x: that face
@@ -171,10 +186,10 @@ bool cone_from(int x, const std::vector<Polygon>& face_polys, const std::vector<
                const std::vector<std::vector<int>>& loops, bool apex_is_centre,
                const std::vector<int>& component_points, int fan, Tessellation& tess) {
   if (x < kPrivatePoint0) {
-    for (int f : faces_touching(x))
-      for (std::size_t i = 0; i < face_polys.size(); ++i)
-        if (poly_face[i] == f && !(face_polys[i].size == 3 && contains(face_polys[i], x)))
-          return false;
+    for (std::size_t i = 0; i < face_polys.size(); ++i)
+      if ((faces_touching(x) >> poly_face[i] & 1) &&
+          !(face_polys[i].size == 3 && contains(face_polys[i], x)))
+        return false;
   }
   int next_private = kPrivatePoint0;
   if (apex_is_centre) {
@@ -208,15 +223,8 @@ bool cone_from(int x, const std::vector<Polygon>& face_polys, const std::vector<
     }
   }
   // An isosurface triangle lying flat on a cube face would coincide with the face itself.
-  for (const auto& t : tess.iso_triangles) {
-    if (t.p[0] >= kPrivatePoint0 || t.p[1] >= kPrivatePoint0 || t.p[2] >= kPrivatePoint0) continue;
-    for (int f : faces_touching(t.p[0])) {
-      const auto fb = faces_touching(t.p[1]), fc = faces_touching(t.p[2]);
-      if (std::find(fb.begin(), fb.end(), f) != fb.end() &&
-          std::find(fc.begin(), fc.end(), f) != fc.end())
-        return false;
-    }
-  }
+  for (const auto& t : tess.iso_triangles)
+    if (on_one_cube_face(t)) return false;
   auto add_cone = [&](const Polygon& poly) {
     if (contains(poly, x)) return;
     CellTemplate cell;
@@ -231,6 +239,226 @@ bool cone_from(int x, const std::vector<Polygon>& face_polys, const std::vector<
   for (const auto& poly : face_polys) add_cone(poly);
   for (const auto& poly : tess.iso_triangles) add_cone(poly);
   return true;
+}
+
+// The fewest cells that fill a component using its own points only (no private point): an
+// advancing front over the component's boundary, where each step puts a tetrahedron on a front
+// triangle or a pyramid on a front quadrilateral, with its apex at one of the component's points.
+// When the front closes and every cell is positive at every sampled placement, the cells tile the
+// component at those placements (their boundary is the component's, and no cell is inverted), so
+// no overlap test is needed.
+class FewestCells {
+ public:
+  FewestCells(const std::vector<Points>& samples, const std::vector<int>& points)
+      : samples_(samples), points_(points) {}
+
+  // The fill with the fewest cells found for this boundary (outward polygons), or none; the
+  // search stops after a fixed number of steps and keeps the best found by then.
+  std::vector<CellTemplate> search(const std::vector<Polygon>& boundary) {
+    front_.clear();
+    for (const auto& f : boundary) front_.push_back(canonical(f));
+    cells_.clear();
+    best_.clear();
+    steps_ = 0;
+    dfs();
+    return best_;
+  }
+
+ private:
+  static constexpr long kMaxSteps = 100;
+
+  struct Move {
+    std::size_t base;  // front polygon the cell stands on
+    int apex;
+  };
+
+  // An oriented polygon rotated to start at its smallest id: then two polygons are the same
+  // oriented polygon exactly when their ids are equal.
+  static Polygon canonical(Polygon f) {
+    int first = 0;
+    for (int i = 1; i < f.size; ++i)
+      if (f.p[i] < f.p[first]) first = i;
+    std::rotate(f.p.begin(), f.p.begin() + first, f.p.begin() + f.size);
+    return f;
+  }
+  // (A canonical triangle's unused fourth id is 0, which a canonical quadrilateral never has
+  // there, so the four ids alone tell them apart.)
+  static bool same(const Polygon& a, const Polygon& b) {
+    std::uint32_t x, y;
+    std::memcpy(&x, a.p.data(), 4);
+    std::memcpy(&y, b.p.data(), 4);
+    return x == y;
+  }
+  // The cell on the inner side of front polygon f with apex x (f's normal points away from the
+  // unfilled region, as cone_from's bases).
+  static CellTemplate cone(const Polygon& f, int x) {
+    const auto ux = static_cast<std::uint8_t>(x);
+    const auto& p = f.p;
+    if (f.size == 3) return {4, {p[0], p[2], p[1], ux, 0}};
+    return {5, {p[0], p[3], p[2], p[1], ux}};
+  }
+  bool positive(const CellTemplate& c) {
+    std::uint64_t key = c.size;
+    for (int i = 0; i < c.size; ++i) key = key << 6 | c.p[i];
+    if (const auto it = memo_.find(key); it != memo_.end()) return it->second;
+    Tessellation t;
+    t.cells.push_back(c);
+    bool ok = true;
+    for (const auto& s : samples_) {
+      Points x = s;
+      if (!(place_and_measure(t, x, false).volume6 > 6e-14)) {
+        ok = false;
+        break;
+      }
+    }
+    memo_.emplace(key, ok);
+    return ok;
+  }
+
+  // How many front polygons the move's cell closes besides its base, or −1 when a side face
+  // would double a front polygon or lie on a cube face without closing against the boundary
+  // there (nothing could close it later).
+  int closes(const Move& m) const {
+    const Polygon& base = front_[m.base];
+    int closed = 0;
+    for (int e = 0; e < base.size; ++e) {
+      const int a = base.p[e], b = base.p[(e + 1) % base.size];
+      const Polygon outward = canonical(tri(b, a, m.apex)), inward = canonical(tri(a, b, m.apex));
+      bool found = false;
+      for (std::size_t i = 0; i < front_.size() && !found; ++i) {
+        if (i == m.base) continue;
+        if (same(front_[i], outward))
+          found = true;
+        else if (same(front_[i], inward))
+          return -1;
+      }
+      if (found)
+        ++closed;
+      else if (on_one_cube_face(inward))
+        return -1;
+    }
+    return closed;
+  }
+
+  // The front after a move that closes().
+  void advance(const Move& m, std::vector<Polygon>& next) const {
+    const Polygon& base = front_[m.base];
+    next.clear();
+    for (std::size_t i = 0; i < front_.size(); ++i)
+      if (i != m.base) next.push_back(front_[i]);
+    for (int e = 0; e < base.size; ++e) {
+      const int a = base.p[e], b = base.p[(e + 1) % base.size];
+      const Polygon outward = canonical(tri(b, a, m.apex));
+      const auto at = std::find_if(next.begin(), next.end(),
+                                   [&](const Polygon& f) { return same(f, outward); });
+      if (at != next.end())
+        next.erase(at);
+      else
+        next.push_back(canonical(tri(a, b, m.apex)));
+    }
+  }
+
+  // The cells that can close front polygon i: cones on it, and for a triangle, pyramids on a
+  // front quadrilateral that have it as a side.
+  // Stops at `limit` moves: the caller only needs to know that there are that many.
+  void moves_closing(std::size_t i, std::vector<Move>& moves, std::size_t limit) {
+    moves.clear();
+    const Polygon& f = front_[i];
+    auto consider = [&](const Move& m) {
+      if (closes(m) >= 0 && positive(cone(front_[m.base], m.apex))) moves.push_back(m);
+      return moves.size() < limit;
+    };
+    for (int x : points_)
+      if (!contains(f, x) && !consider({i, x})) return;
+    if (f.size != 3) return;
+    for (std::size_t j = 0; j < front_.size(); ++j) {
+      const Polygon& q = front_[j];
+      if (q.size != 4) continue;
+      for (int e = 0; e < 4; ++e) {
+        // The side on quad edge a → b is (b, a, apex): the triangle's third point.
+        const int a = q.p[e], b = q.p[(e + 1) % 4];
+        for (int k = 0; k < 3; ++k)
+          if (f.p[k] == b && f.p[(k + 1) % 3] == a && !contains(q, f.p[(k + 2) % 3]) &&
+              !consider({j, f.p[(k + 2) % 3]}))
+            return;
+      }
+    }
+  }
+
+  void dfs() {
+    if (++steps_ > kMaxSteps) return;
+    if (front_.empty()) {
+      if (best_.empty() || cells_.size() < best_.size()) best_ = cells_;
+      return;
+    }
+    // Each cell removes at most five front polygons (a pyramid closing against all its sides).
+    if (!best_.empty() && cells_.size() + (front_.size() + 4) / 5 >= best_.size()) return;
+    // The front polygon with the fewest ways to close it first.
+    std::vector<Move> moves, fewest;
+    for (std::size_t i = 0; i < front_.size(); ++i) {
+      moves_closing(i, moves, i == 0 ? points_.size() + front_.size() : fewest.size());
+      if (i == 0 || moves.size() < fewest.size()) fewest.swap(moves);
+      if (fewest.empty()) return;
+      if (fewest.size() == 1) break;  // forced
+    }
+    // Moves that close the most first: good fills are found early.
+    std::vector<std::pair<int, std::size_t>> order;
+    for (std::size_t k = 0; k < fewest.size(); ++k) order.push_back({-closes(fewest[k]), k});
+    std::sort(order.begin(), order.end());
+    std::vector<Polygon> next;
+    for (const auto& [closed, k] : order) {
+      const Move m = fewest[k];
+      advance(m, next);
+      const CellTemplate cell = cone(front_[m.base], m.apex);
+      std::vector<Polygon> saved = std::move(front_);
+      front_ = std::move(next);
+      cells_.push_back(cell);
+      dfs();
+      cells_.pop_back();
+      front_ = std::move(saved);
+      if (steps_ > kMaxSteps) return;
+    }
+  }
+
+  const std::vector<Points>& samples_;
+  const std::vector<int>& points_;
+  std::vector<Polygon> front_;
+  std::vector<CellTemplate> cells_, best_;
+  std::unordered_map<std::uint64_t, bool> memo_;
+  long steps_ = 0;
+};
+
+// Fills with the fewest cells on the component's own points (FewestCells), one for each way of
+// fanning its isosurface loops from one of their points, up to kMaxLoopFans ways.
+std::vector<Tessellation> fewest_cell_fills(const std::vector<Points>& samples,
+                                            const std::vector<int>& points,
+                                            const std::vector<Polygon>& face_polys,
+                                            const std::vector<std::vector<int>>& loops) {
+  std::vector<Tessellation> fills;
+  FewestCells fewest(samples, points);
+  std::vector<int> fan(loops.size(), 0);
+  for (int combination = 0; combination < kMaxLoopFans; ++combination) {
+    Tessellation tess;
+    for (std::size_t l = 0; l < loops.size(); ++l) {
+      const auto& loop = loops[l];
+      const int n = static_cast<int>(loop.size()), s = fan[l];
+      for (int i = 1; i + 1 < n; ++i)
+        tess.iso_triangles.push_back(tri(loop[s], loop[(s + i) % n], loop[(s + i + 1) % n]));
+    }
+    // An isosurface triangle flat on a cube face would coincide with the face itself.
+    if (std::none_of(tess.iso_triangles.begin(), tess.iso_triangles.end(), on_one_cube_face)) {
+      std::vector<Polygon> boundary = face_polys;
+      boundary.insert(boundary.end(), tess.iso_triangles.begin(), tess.iso_triangles.end());
+      tess.cells = fewest.search(boundary);
+      if (!tess.cells.empty()) fills.push_back(std::move(tess));
+    }
+    std::size_t l = 0;  // the next combination: an odometer over the loops' fan points
+    while (l < loops.size() &&
+           ++fan[l] >= (loops[l].size() == 3 ? 1 : static_cast<int>(loops[l].size())))
+      fan[l++] = 0;
+    if (l == loops.size()) break;
+  }
+  return fills;
 }
 
 CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler& sampler) {
@@ -274,6 +502,10 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
     }
     loops.push_back(loop);
   }
+
+  std::vector<Points> samples(sampler.params.size());
+  for (std::size_t s = 0; s < samples.size(); ++s)
+    sample_points(entry, sampler.params[s], samples[s]);
 
   std::map<int, int> root_to_component;
   for (const auto& p : polys) root_to_component.emplace(uf.find(p.p[0]), 0);
@@ -335,63 +567,69 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
     }
     std::stable_sort(ranked.begin(), ranked.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
+    if (ranked.size() > kSingleApexKept) ranked.resize(kSingleApexKept);
+    // The multi-apex fills come after: fewer cells and nodes, but the thin solution near the
+    // wall that costs accuracy (docs/results/mesh-speed.md#multi-apex-fills), so taken only where
+    // no single-apex fill is well shaped and they are better shaped.
+    std::vector<Tessellation> multi = fewest_cell_fills(samples, cpoints, cpolys, cloops);
+    std::stable_sort(multi.begin(), multi.end(),
+                     [](const auto& a, const auto& b) { return a.cells.size() < b.cells.size(); });
     Component comp;
+    for (auto& r : ranked) comp.candidates.push_back(std::move(r.second));
+    for (std::size_t i = 0; i < std::min(multi.size(), kMultiApexKept); ++i)
+      comp.candidates.push_back(std::move(multi[i]));
     {
       std::array<double, 12> mid;
       mid.fill(0.5);
       Points pts;
       sample_points(entry, mid, pts);
       double best_shape = -INFINITY;
-      for (std::size_t r = 0; r < std::min<std::size_t>(ranked.size(), 6); ++r) {
+      for (std::size_t r = 0; r < comp.candidates.size(); ++r) {
         Points copy = pts;
-        const FillMeasure m = place_and_measure(ranked[r].second, copy);
+        const FillMeasure m = place_and_measure(comp.candidates[r], copy);
         if (!(m.volume6 > 6e-12)) continue;
         if (m.shape > best_shape)
           best_shape = m.shape, comp.midpoint_candidate = static_cast<int>(r);
+        if (m.shape >= kGoodShape) break;
       }
     }
     comp.face_polygons = cpolys;
     for (const auto& loop : cloops) comp.loops.emplace_back(loop.begin(), loop.end());
-    for (auto& r : ranked) {
-      if (comp.candidates.size() >= 6) break;
-      comp.candidates.push_back(std::move(r.second));
-    }
     entry.components.push_back(std::move(comp));
   }
   return entry;
 }
 
+// Entries are built on first use: a mesh meets few of them, and each entry's fewest-cell search
+// costs far more than looking it up.
 struct Table {
-  std::vector<CaseEntry> entries;  // 256 × 64, only masks ⊆ ambiguous faces filled
-  std::size_t distinct = 0;
-  Table() : entries(256 * 64) {
-    const Sampler sampler;
-    for (int config = 0; config < 256; ++config) {
-      const auto amb = ambiguous_faces(static_cast<std::uint8_t>(config));
-      for (int mask = 0; mask < 64; ++mask) {
-        if ((mask & ~amb) != 0) continue;
-        entries[static_cast<std::size_t>(config * 64 + mask)] = build_entry(
-            static_cast<std::uint8_t>(config), static_cast<std::uint8_t>(mask), sampler);
-        ++distinct;
-      }
-    }
+  std::vector<CaseEntry> entries = std::vector<CaseEntry>(256 * 64);
+  std::vector<std::once_flag> built = std::vector<std::once_flag>(256 * 64);
+  const Sampler sampler;
+  const CaseEntry& at(std::uint8_t config, std::uint8_t mask) {
+    const std::size_t i = static_cast<std::size_t>(config) * 64 + mask;
+    std::call_once(built[i], [&] { entries[i] = build_entry(config, mask, sampler); });
+    return entries[i];
   }
 };
 
-const Table& table() {
-  static const Table t;
+Table& table() {
+  static Table t;
   return t;
 }
 
 }  // namespace
 
 const CaseEntry& case_entry(std::uint8_t config, std::uint8_t connected) {
-  const auto mask = static_cast<std::uint8_t>(connected & ambiguous_faces(config));
-  return table().entries[static_cast<std::size_t>(config) * 64 + mask];
+  return table().at(config, static_cast<std::uint8_t>(connected & ambiguous_faces(config)));
 }
 
 std::size_t case_entry_count() {
-  return table().distinct;
+  std::size_t distinct = 0;
+  for (int config = 0; config < 256; ++config)
+    distinct +=
+        std::size_t{1} << __builtin_popcount(ambiguous_faces(static_cast<std::uint8_t>(config)));
+  return distinct;
 }
 
 }  // namespace naris::mve

@@ -59,7 +59,8 @@ struct PrivatePoint {
 };
 
 // One way to fill a connected inside component of the cube: cones from one apex over the
-// component's boundary polygons, and the triangulation of its isosurface loops.
+// component's boundary polygons, or the fewest cells on the component's own points (apexes at
+// several of them), and the triangulation of its isosurface loops.
 struct Tessellation {
   std::vector<PrivatePoint> privates;  // local ids 26, 27, ... in order
   std::vector<CellTemplate> cells;
@@ -67,15 +68,15 @@ struct Tessellation {
 };
 
 struct Component {
-  // Alternatives, the most robust first. Of those whose cells all have positive volume for the
-  // actual isopoint positions, the mesher takes the first that is well shaped, else the best
-  // shaped (fill_component.h).
+  // Alternatives, the most robust first and, among equally robust ones, the fewest cells first.
+  // Of those whose cells all have positive volume for the actual isopoint positions, the mesher
+  // takes the first that is well shaped, else the best shaped (fill_component.h).
   std::vector<Tessellation> candidates;
   // The component's boundary as the table sees it, for a search at run time when no candidate
   // fits (rare: components with two or more isosurface loops and extreme isopoints).
   std::vector<Polygon> face_polygons;
   std::vector<std::vector<std::uint8_t>> loops;  // outward oriented
-  // The candidate valid and best shaped when every isopoint is an edge midpoint (binary fields),
+  // The candidate the mesher would take when every isopoint is an edge midpoint (binary fields),
   // where a cube's shape depends on its configuration alone; -1 if none (then chosen at run time).
   int midpoint_candidate = -1;
 };

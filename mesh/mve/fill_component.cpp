@@ -8,9 +8,6 @@ namespace {
 
 // Cells thinner than this (6× volume, in units of the voxel) count as invalid.
 constexpr double kMinVolume6 = 1e-12;
-// A valid candidate whose worst corner Jacobian reaches this is taken without trying the others:
-// searching on from there changes no measured quality (docs/results/relocation.md).
-constexpr double kGoodShape = 0.3;
 
 using Points = std::array<Eigen::Vector3d, kMaxLocalPoints>;
 

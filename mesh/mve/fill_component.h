@@ -14,6 +14,9 @@
 namespace naris::mve {
 
 inline constexpr int kMaxLocalPoints = 96;
+// A valid candidate whose worst corner Jacobian reaches this is taken without trying the others:
+// searching on from there changes no measured quality (docs/results/relocation.md).
+inline constexpr double kGoodShape = 0.3;
 
 struct ComponentFill {
   // Cells and isosurface triangles in local ids; ids from kPrivatePoint0 on are new points whose
