@@ -1,7 +1,7 @@
 // `naris run case.yaml`: the stages of a case, from the CT (or the phantom) to the flow, its
 // particle paths and its cross-sections, one file (or folder) each. A stage is skipped when its
-// outputs are newer than its inputs and its settings are the ones it last ran with (kept in
-// <output>/.naris-run/); `--force` runs everything.
+// outputs are newer than its inputs (the executable included) and its settings are the ones it
+// last ran with (kept in <output>/.naris-run/); `--force` runs everything.
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
@@ -103,7 +103,11 @@ bool up_to_date(const Stage& s, const fs::path& stamp) {
   std::stringstream text;
   text << in.rdbuf();
   if (text.str() != s.settings) return false;
-  fs::file_time_type newest_input = fs::file_time_type::min();
+  // The program that wrote the outputs is one of their inputs: a rebuilt naris runs them again.
+  std::error_code error;
+  fs::file_time_type newest_input =
+      fs::last_write_time(fs::read_symlink("/proc/self/exe", error), error);
+  if (error) newest_input = fs::file_time_type::min();
   for (const auto& p : s.inputs) {
     if (!fs::exists(p)) return false;
     newest_input = std::max(newest_input, fs::last_write_time(p));

@@ -511,6 +511,16 @@ TEST_F(CliRunCase, RunsEveryStageThenSkipsThoseUpToDate) {
   EXPECT_NE(r.err.find("] segment\n"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("] mesh\n"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("threshold -400.0 HU (given)"), std::string::npos) << r.err;
+  // A naris newer than the outputs (as after a rebuild) runs every stage again, once.
+  const fs::path rebuilt = dir_ / "naris";
+  fs::copy_file(NARIS_BINARY, rebuilt);
+  for (int run = 0; run < 2; ++run) {
+    const std::string err = dir_ / "stderr.txt";
+    ASSERT_EQ(std::system((rebuilt.string() + " run " + c.string() + " 2> " + err).c_str()), 0);
+    std::ifstream in(err);
+    const std::string log((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_EQ(log.find("up to date, skipped") == std::string::npos, run == 0) << log;
+  }
 }
 
 TEST_F(CliRunCase, BadCaseFilesAreClearErrors) {
