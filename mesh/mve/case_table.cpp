@@ -265,7 +265,7 @@ class FewestCells {
   }
 
  private:
-  static constexpr long kMaxSteps = 100;
+  static constexpr long kMaxSteps = 2000;
 
   struct Move {
     std::size_t base;  // front polygon the cell stands on
@@ -452,10 +452,11 @@ std::vector<Tessellation> fewest_cell_fills(const std::vector<Points>& samples,
       tess.cells = fewest.search(boundary);
       if (!tess.cells.empty()) fills.push_back(std::move(tess));
     }
-    std::size_t l = 0;  // the next combination: an odometer over the loops' fan points
-    while (l < loops.size() &&
-           ++fan[l] >= (loops[l].size() == 3 ? 1 : static_cast<int>(loops[l].size())))
-      fan[l++] = 0;
+    // The next combination: an odometer over the loops' distinct fans (a triangle has one, a
+    // quadrilateral two: fans from opposite corners share their diagonal).
+    auto fans = [](std::size_t n) { return n == 3 ? 1 : n == 4 ? 2 : static_cast<int>(n); };
+    std::size_t l = 0;
+    while (l < loops.size() && ++fan[l] >= fans(loops[l].size())) fan[l++] = 0;
     if (l == loops.size()) break;
   }
   return fills;
@@ -568,9 +569,9 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler
     std::stable_sort(ranked.begin(), ranked.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
     if (ranked.size() > kSingleApexKept) ranked.resize(kSingleApexKept);
-    // The multi-apex fills come after: fewer cells and nodes, but the thin solution near the
-    // wall that costs accuracy (docs/results/mesh-speed.md#multi-apex-fills), so taken only where
-    // no single-apex fill is well shaped and they are better shaped.
+    // The multi-apex fills come after: they have fewer cells and nodes, but ranked first they
+    // made the drag on a sphere converge worse (docs/results/forces.md), so a cube takes one only
+    // where no single-apex fill is well shaped and it is better shaped.
     std::vector<Tessellation> multi = fewest_cell_fills(samples, cpoints, cpolys, cloops);
     std::stable_sort(multi.begin(), multi.end(),
                      [](const auto& a, const auto& b) { return a.cells.size() < b.cells.size(); });

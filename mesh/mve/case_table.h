@@ -68,9 +68,10 @@ struct Tessellation {
 };
 
 struct Component {
-  // Alternatives, the most robust first and, among equally robust ones, the fewest cells first.
-  // Of those whose cells all have positive volume for the actual isopoint positions, the mesher
-  // takes the first that is well shaped, else the best shaped (fill_component.h).
+  // Alternatives: the single-apex fills, the most robust first and, among equally robust ones,
+  // the fewest cells first; then the multi-apex fills, the fewest cells first. Of those whose
+  // cells all have positive volume for the actual isopoint positions, the mesher takes the first
+  // that is well shaped, else the best shaped (fill_component.h).
   std::vector<Tessellation> candidates;
   // The component's boundary as the table sees it, for a search at run time when no candidate
   // fits (rare: components with two or more isosurface loops and extreme isopoints).
