@@ -2,10 +2,13 @@
 // §6): a tube of diameter D bent at R_b = 5.7 D/2, meshed by MVE from the sampled torus at
 // several resolutions, the steady laminar flow solved by naris at Re 1000 with a developed inlet
 // profile, flux-weighted particles, Stokes drag. Stk = ρ_p d² C_c Ū / (9 μ D) = τ Ū / (D/2).
-// Prints one row per resolution and Stokes number. With --uniform-inlet the air enters the bend
-// with a flat profile instead (a bend fed by a short straight tube).
+// Prints one row per resolution and Stokes number, with the correlation read with this Stk and
+// with τŪ/D (VERIFICATION.md's convention, half of it). With --uniform-inlet the air enters the
+// bend with a flat profile instead (a bend fed by a short straight tube). --diameter sets the
+// particles' diameter in µm (2 by default: d/D = 0.002 as in Pui's tubes; the density follows
+// from Stk), in a tube 1 mm across, since deposition reaches d/2 from the wall.
 //
-//   bench_deposition [--uniform-inlet] [particles = 10000] [cells across D ...= 14 20 28]
+//   bench_deposition [--uniform-inlet] [--diameter µm] [particles = 10000] [cells across D ...]
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -27,19 +30,27 @@ using namespace naris::particles;
 int main(int argc, char** argv) {
   petsc::Session session;
   set_verbosity(Verbosity::quiet);
-  int first = 1;
-  const bool uniform = argc > 1 && std::string(argv[1]) == "--uniform-inlet";
-  if (uniform) ++first;
-  const int n = argc > first ? std::atoi(argv[first]) : 10000;
-  std::vector<int> resolutions;
-  for (int i = first + 1; i < argc; ++i) resolutions.push_back(std::atoi(argv[i]));
+  bool uniform = false;
+  double diameter = 2e-6;
+  std::vector<int> numbers;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--uniform-inlet")
+      uniform = true;
+    else if (arg == "--diameter" && i + 1 < argc)
+      diameter = std::atof(argv[++i]) * 1e-6;
+    else
+      numbers.push_back(std::atoi(argv[i]));
+  }
+  const int n = numbers.empty() ? 10000 : numbers.front();
+  std::vector<int> resolutions(numbers.begin() + (numbers.empty() ? 0 : 1), numbers.end());
   if (resolutions.empty()) resolutions = {14, 20, 28};
   // Lengths in units of D (read as millimetres), the velocity in units of Ū (read as m/s).
   const double a = 0.5, bend = 2.85, re = 1000.0;
   std::printf(
-      "| cells across D | cells | Stk | deposited | Pui et al. | difference | particles | lost | "
-      "trace (s) |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+      "| cells across D | cells | Stk = τŪ/(D/2) | deposited | Pui et al., this Stk | difference | "
+      "Pui et al., Stk = τŪ/D | difference | particles | lost | trace (s) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int across : resolutions) {
     mve::MveOptions options;
     options.side_patch[0] = "outlet";
@@ -65,8 +76,8 @@ int main(int argc, char** argv) {
     const ReleaseSet seeds = flux_weighted_release(m, m.patch_id("inlet"), field.velocity, n, 1987);
     TraceOptions o;
     o.drag = DragLaw::stokes;  // Stk defines the particle
-    for (double stk : {0.1, 0.2, 0.3, 0.5}) {
-      const double d = 10e-6, cc = cunningham_factor(d, o.air.mean_free_path);
+    for (double stk : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 1.0}) {
+      const double d = diameter, cc = cunningham_factor(d, o.air.mean_free_path);
       const ParticleKind kind{d, 18.0 * o.air.viscosity * (stk * a * 1e-3) / (d * d * cc)};
       Stopwatch clock;
       int counts[kFates] = {};
@@ -74,11 +85,13 @@ int main(int argc, char** argv) {
         ++counts[static_cast<int>(
             track(flow, {x, std::nullopt, flow.locate(x)}, kind, o, {}, false).fate)];
       const double eta = counts[static_cast<int>(Fate::wall)] / double(n);
-      const double q = stk / 0.171;
-      const double pui = 1.0 - std::pow(1.0 + std::pow(q, 0.452 * q + 2.242), -1.0);
-      std::printf("| %d | %zu | %.1f | %.3f | %.3f | %+.3f | %d | %d | %.1f |\n", across,
-                  m.cell_count(), stk, eta, pui, eta - pui, n, counts[static_cast<int>(Fate::lost)],
-                  clock.seconds());
+      auto pui = [](double stokes) {
+        const double q = stokes / 0.171;
+        return 1.0 - std::pow(1.0 + std::pow(q, 0.452 * q + 2.242), -1.0);
+      };
+      std::printf("| %d | %zu | %.1f | %.3f | %.3f | %+.3f | %.3f | %+.3f | %d | %d | %.1f |\n",
+                  across, m.cell_count(), stk, eta, pui(stk), eta - pui(stk), pui(0.5 * stk),
+                  eta - pui(0.5 * stk), n, counts[static_cast<int>(Fate::lost)], clock.seconds());
       std::fflush(stdout);
     }
   }
