@@ -1,7 +1,8 @@
 #pragma once
-// Integrals of nodal fields over a boundary patch, face by face (each face's vector area times
-// the mean of its corner values): the flux through inlets and outlets, mean pressures; the
-// momentum flux by a rule exact for the product of two linear fields.
+// Integrals of nodal fields over a boundary patch, face by face: the flux through inlets and
+// outlets (exact for the cells' traces, linear on triangles and bilinear on quadrilaterals), mean
+// pressures (each face's area times the mean of its corners); the momentum flux by a rule exact
+// for the product of two linear fields.
 #include <vector>
 
 #include "mesh/hybrid_mesh.h"
