@@ -20,6 +20,25 @@ int edge_between(int a, int b) {
   return -1;
 }
 
+std::uint8_t edge_faces(std::uint8_t config) {
+  std::uint8_t mask = 0;
+  for (int f = 0; f < 6; ++f) {
+    const auto& c = kFace[f];
+    int inside = 0;
+    bool adjacent = false;
+    for (int i = 0; i < 4; ++i) {
+      inside += config >> c[i] & 1;
+      adjacent = adjacent || ((config >> c[i] & 1) && (config >> c[(i + 1) % 4] & 1));
+    }
+    if (inside == 2 && adjacent) mask |= static_cast<std::uint8_t>(1u << f);
+  }
+  return mask;
+}
+
+std::uint8_t choice_faces(std::uint8_t config) {
+  return ambiguous_faces(config) | edge_faces(config);
+}
+
 std::uint8_t ambiguous_faces(std::uint8_t config) {
   std::uint8_t mask = 0;
   for (int f = 0; f < 6; ++f) {
@@ -51,7 +70,7 @@ bool contains(const Polygon& poly, int x) {
 
 // The face tessellation rules of 3.2.3 for face f. Every polygon is counter-clockwise seen from
 // outside the cube.
-void tessellate_face(std::uint8_t config, std::uint8_t connected, int f, CaseEntry& entry) {
+void tessellate_face(std::uint8_t config, std::uint8_t choices, int f, CaseEntry& entry) {
   const auto& c = kFace[f];
   bool in[4];
   int count = 0;
@@ -78,7 +97,9 @@ void tessellate_face(std::uint8_t config, std::uint8_t connected, int f, CaseEnt
     case 2: {
       int m = 0;
       while (m < 4 && !(in[m] && in[(m + 1) % 4])) ++m;
-      if (m < 4) {  // rule 3: one inside edge; three triangles through the face point
+      if (m < 4 && (choices >> f & 1)) {  // one inside edge, a whole trapezoid (case_table.h)
+        out.push_back(quad(iso(m + 3), v(m), v(m + 1), iso(m + 1)));
+      } else if (m < 4) {  // rule 3: one inside edge; three triangles through the face point
         const int fp = kFacePoint0 + f;
         out.push_back(tri(fp, iso(m + 3), v(m)));
         out.push_back(tri(fp, v(m), v(m + 1)));
@@ -90,7 +111,7 @@ void tessellate_face(std::uint8_t config, std::uint8_t connected, int f, CaseEnt
         m = in[0] ? 0 : 1;
         out.push_back(tri(v(m), iso(m), iso(m + 3)));
         out.push_back(tri(v(m + 2), iso(m + 2), iso(m + 1)));
-        if (connected >> f & 1) out.push_back(quad(iso(m), iso(m + 1), iso(m + 2), iso(m + 3)));
+        if (choices >> f & 1) out.push_back(quad(iso(m), iso(m + 1), iso(m + 2), iso(m + 3)));
       }
       break;
     }
@@ -462,9 +483,9 @@ std::vector<Tessellation> fewest_cell_fills(const std::vector<Points>& samples,
   return fills;
 }
 
-CaseEntry build_entry(std::uint8_t config, std::uint8_t connected, const Sampler& sampler) {
+CaseEntry build_entry(std::uint8_t config, std::uint8_t face_choices, const Sampler& sampler) {
   CaseEntry entry;
-  for (int f = 0; f < 6; ++f) tessellate_face(config, connected, f, entry);
+  for (int f = 0; f < 6; ++f) tessellate_face(config, face_choices, f, entry);
   for (int e = 0; e < 12; ++e)
     if ((config >> kEdge[e][0] & 1) != (config >> kEdge[e][1] & 1))
       entry.edge_mask |= static_cast<std::uint16_t>(1u << e);
@@ -621,15 +642,15 @@ Table& table() {
 
 }  // namespace
 
-const CaseEntry& case_entry(std::uint8_t config, std::uint8_t connected) {
-  return table().at(config, static_cast<std::uint8_t>(connected & ambiguous_faces(config)));
+const CaseEntry& case_entry(std::uint8_t config, std::uint8_t choices) {
+  return table().at(config, static_cast<std::uint8_t>(choices & choice_faces(config)));
 }
 
 std::size_t case_entry_count() {
   std::size_t distinct = 0;
   for (int config = 0; config < 256; ++config)
     distinct +=
-        std::size_t{1} << __builtin_popcount(ambiguous_faces(static_cast<std::uint8_t>(config)));
+        std::size_t{1} << __builtin_popcount(choice_faces(static_cast<std::uint8_t>(config)));
   return distinct;
 }
 

@@ -93,12 +93,23 @@ struct CaseEntry {
 
 // Faces whose inside vertices are the two ends of one diagonal (ambiguous faces, 3.2.2).
 std::uint8_t ambiguous_faces(std::uint8_t config);
+// Faces whose inside vertices are the two ends of one edge (rule 3 of 3.2.3).
+std::uint8_t edge_faces(std::uint8_t config);
+// The faces tessellated one of two ways: ambiguous faces and edge faces.
+std::uint8_t choice_faces(std::uint8_t config);
 
-// Bit v of config is set when vertex v is inside. Bit f of connected is set when the inside
-// diagonal of ambiguous face f is connected (saddle value inside); other bits are ignored.
-const CaseEntry& case_entry(std::uint8_t config, std::uint8_t connected);
+// An edge face's inside part is a trapezoid between the inside edge and its two isopoints. When
+// both isopoints are edge midpoints (a labelmap's faces, but near its cut planes) it stays whole,
+// a pyramid base: far fewer cells than the three triangles through the face point of rule 3, and
+// better shaped. Otherwise it is rule 3's triangles, whose short edges the collapses of 3.3 can
+// remove (docs/results/mesh-speed.md#trapezoids-kept-whole-2026-12-07).
 
-// Number of distinct (configuration, saddle outcome) entries.
+// Bit v of config is set when vertex v is inside. Bit f of choices chooses for face f: for an
+// ambiguous face, its inside diagonal is connected (saddle value inside); for an edge face, it
+// stays a trapezoid. Other bits are ignored.
+const CaseEntry& case_entry(std::uint8_t config, std::uint8_t choices);
+
+// Number of distinct (configuration, face choices) entries.
 std::size_t case_entry_count();
 
 // Edge id joining two cube vertices, or -1.

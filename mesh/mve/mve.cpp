@@ -373,19 +373,32 @@ class Mesher {
       return;
     }
 
+    // Each face's choice depends on its own four values only, so both cubes sharing it agree.
     // Ambiguous faces: the bilinear saddle value decides (eq. 3.1–3.4). With the inside diagonal
     // (a, c) and the outside one (b, d), the saddle is inside iff a·c > b·d; ties separate.
+    // Edge faces stay whole trapezoids where both isopoints are edge midpoints, as everywhere on
+    // a labelmap but near its cut planes (case_table.h).
     const std::uint8_t amb = ambiguous_faces(static_cast<std::uint8_t>(config));
-    std::uint8_t connected = 0;
+    const std::uint8_t edge = edge_faces(static_cast<std::uint8_t>(config));
+    std::uint8_t choices = 0;
     for (int fc = 0; fc < 6; ++fc) {
-      if (!(amb >> fc & 1)) continue;
       const auto& c = kFace[fc];
+      if (edge >> fc & 1) {
+        bool midpoints = true;
+        for (int n = 0; n < 4; ++n) {
+          const float a = f[c[n]], b = f[c[(n + 1) % 4]];
+          if ((a > 0.0f) != (b > 0.0f)) midpoints = midpoints && a == -b;
+        }
+        if (midpoints) choices |= static_cast<std::uint8_t>(1u << fc);
+        continue;
+      }
+      if (!(amb >> fc & 1)) continue;
       const bool first_inside = f[c[0]] > 0.0f;
       const double pin = first_inside ? double(f[c[0]]) * f[c[2]] : double(f[c[1]]) * f[c[3]];
       const double pout = first_inside ? double(f[c[1]]) * f[c[3]] : double(f[c[0]]) * f[c[2]];
-      if (pin > pout) connected |= static_cast<std::uint8_t>(1u << fc);
+      if (pin > pout) choices |= static_cast<std::uint8_t>(1u << fc);
     }
-    const CaseEntry& entry = case_entry(static_cast<std::uint8_t>(config), connected);
+    const CaseEntry& entry = case_entry(static_cast<std::uint8_t>(config), choices);
 
     for (int v = 0; v < 8; ++v) {
       if (!(config >> v & 1)) continue;

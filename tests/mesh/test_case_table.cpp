@@ -94,9 +94,10 @@ Filled fill(const CaseEntry& e, const std::array<double, 12>& t) {
 template <class F>
 void for_each_entry(F&& f) {
   for (int config = 0; config < 256; ++config) {
-    const auto amb = ambiguous_faces(static_cast<std::uint8_t>(config));
+    const auto choice = choice_faces(static_cast<std::uint8_t>(config));
     for (int mask = 0; mask < 64; ++mask)
-      if ((mask & ~amb) == 0) f(static_cast<std::uint8_t>(config), static_cast<std::uint8_t>(mask));
+      if ((mask & ~choice) == 0)
+        f(static_cast<std::uint8_t>(config), static_cast<std::uint8_t>(mask));
   }
 }
 
@@ -157,11 +158,12 @@ TEST(CaseTable, FaceRulesGiveTheExpectedPolygonCounts) {
       const bool diagonal = ambiguous_faces(config) >> f & 1;
       const std::size_t expected = inside == 4   ? 1
                                    : inside == 3 ? 3
-                                   : inside == 2 ? (diagonal ? (mask >> f & 1 ? 3 : 2) : 3)
+                                   : inside == 2
+                                       ? (mask >> f & 1 ? (diagonal ? 3 : 1) : (diagonal ? 2 : 3))
                                    : inside == 1 ? 1
                                                  : 0;
       ASSERT_EQ(polys.size(), expected) << "config " << int(config) << " face " << f;
-      if (inside == 4) {
+      if (inside == 4 || (inside == 2 && !diagonal && (mask >> f & 1))) {
         EXPECT_EQ(polys[0].size, 4);
       }
     }
@@ -189,7 +191,7 @@ TEST(CaseTable, EveryConfigurationFillsItsRegionForRandomVertexValues) {
   std::set<std::pair<int, int>> realized;
   std::size_t unresolved = 0, samples = 0;
   for (int config = 1; config < 256; ++config) {
-    std::array<int, 6> seen_connected{}, seen_separated{};
+    std::array<int, 6> seen_connected{}, seen_separated{}, seen_trapezoid{}, seen_face_point{};
     for (int s = 0; s < 600; ++s) {
       std::array<double, 8> f;
       for (int v = 0; v < 8; ++v) f[v] = ((config >> v & 1) ? 1.0 : -1.0) * std::pow(10.0, u(rng));
@@ -200,9 +202,19 @@ TEST(CaseTable, EveryConfigurationFillsItsRegionForRandomVertexValues) {
       }
       std::uint8_t mask = 0;
       const auto amb = ambiguous_faces(static_cast<std::uint8_t>(config));
+      const auto edge_face = edge_faces(static_cast<std::uint8_t>(config));
       for (int fc = 0; fc < 6; ++fc) {
-        if (!(amb >> fc & 1)) continue;
         const auto& c = kFace[fc];
+        if (edge_face >> fc & 1) {  // either tessellation must fill: a coin decides
+          if (rng() & 1) {
+            mask |= static_cast<std::uint8_t>(1u << fc);
+            ++seen_trapezoid[fc];
+          } else {
+            ++seen_face_point[fc];
+          }
+          continue;
+        }
+        if (!(amb >> fc & 1)) continue;
         const bool first = f[c[0]] > 0;
         const double pin = first ? f[c[0]] * f[c[2]] : f[c[1]] * f[c[3]];
         const double pout = first ? f[c[1]] * f[c[3]] : f[c[0]] * f[c[2]];
@@ -227,14 +239,19 @@ TEST(CaseTable, EveryConfigurationFillsItsRegionForRandomVertexValues) {
       ASSERT_NEAR(r.cell_volume, r.boundary_volume, 1e-9) << "config " << config;
     }
     const auto amb = ambiguous_faces(static_cast<std::uint8_t>(config));
+    const auto edge_face = edge_faces(static_cast<std::uint8_t>(config));
     for (int fc = 0; fc < 6; ++fc) {
+      if (edge_face >> fc & 1) {
+        EXPECT_GT(seen_trapezoid[fc], 0) << "config " << config << " face " << fc;
+        EXPECT_GT(seen_face_point[fc], 0) << "config " << config << " face " << fc;
+      }
       if (!(amb >> fc & 1)) continue;
       EXPECT_GT(seen_connected[fc], 0) << "config " << config << " face " << fc;
       EXPECT_GT(seen_separated[fc], 0) << "config " << config << " face " << fc;
     }
   }
   std::printf(
-      "[ info ] %zu (configuration, saddle outcome) pairs realized of %zu table entries; "
+      "[ info ] %zu (configuration, face choices) pairs realized of %zu table entries; "
       "%zu of %zu samples unresolved\n",
       realized.size() + 1, case_entry_count(), unresolved, samples);
   EXPECT_EQ(unresolved, 0u);
