@@ -373,21 +373,36 @@ class Mesher {
       return;
     }
 
-    // Each face's choice depends on its own four values only, so both cubes sharing it agree.
+    for (int v = 0; v < 8; ++v) {
+      if (!(config >> v & 1)) continue;
+      ids[v] = vertex_node(i + kCorner[v][0], j + kCorner[v][1], kCorner[v][2]);
+      x_[v] = mesh_.nodes[ids[v]];
+    }
+    for (int e = 0; e < 12; ++e) {
+      if ((config >> kEdge[e][0] & 1) == (config >> kEdge[e][1] & 1)) continue;
+      ids[kEdgePoint0 + e] = edge_node(i, j, e);
+      x_[kEdgePoint0 + e] = mesh_.nodes[ids[kEdgePoint0 + e]];
+    }
+
+    // Each face's choice depends on that face alone, so both cubes sharing it agree.
     // Ambiguous faces: the bilinear saddle value decides (eq. 3.1–3.4). With the inside diagonal
     // (a, c) and the outside one (b, d), the saddle is inside iff a·c > b·d; ties separate.
-    // Edge faces stay whole trapezoids where both isopoints are edge midpoints, as everywhere on
-    // a labelmap but near its cut planes (case_table.h).
+    // Edge faces stay whole trapezoids where both isopoints (shared nodes) sit exactly at their
+    // edges' midpoints, as everywhere on a labelmap but near its cut planes (case_table.h).
     const std::uint8_t amb = ambiguous_faces(static_cast<std::uint8_t>(config));
     const std::uint8_t edge = edge_faces(static_cast<std::uint8_t>(config));
+    const Eigen::Vector3d corner0(i, j, k_);
     std::uint8_t choices = 0;
     for (int fc = 0; fc < 6; ++fc) {
       const auto& c = kFace[fc];
       if (edge >> fc & 1) {
         bool midpoints = true;
         for (int n = 0; n < 4; ++n) {
-          const float a = f[c[n]], b = f[c[(n + 1) % 4]];
-          if ((a > 0.0f) != (b > 0.0f)) midpoints = midpoints && a == -b;
+          const int e = edge_between(c[n], c[(n + 1) % 4]);
+          if ((config >> kEdge[e][0] & 1) == (config >> kEdge[e][1] & 1)) continue;
+          const int axis = e / 4;
+          midpoints = midpoints &&
+                      x_[kEdgePoint0 + e][axis] - corner0[axis] - kCorner[kEdge[e][0]][axis] == 0.5;
         }
         if (midpoints) choices |= static_cast<std::uint8_t>(1u << fc);
         continue;
@@ -399,17 +414,6 @@ class Mesher {
       if (pin > pout) choices |= static_cast<std::uint8_t>(1u << fc);
     }
     const CaseEntry& entry = case_entry(static_cast<std::uint8_t>(config), choices);
-
-    for (int v = 0; v < 8; ++v) {
-      if (!(config >> v & 1)) continue;
-      ids[v] = vertex_node(i + kCorner[v][0], j + kCorner[v][1], kCorner[v][2]);
-      x_[v] = mesh_.nodes[ids[v]];
-    }
-    for (int e = 0; e < 12; ++e) {
-      if (!(entry.edge_mask >> e & 1)) continue;
-      ids[kEdgePoint0 + e] = edge_node(i, j, e);
-      x_[kEdgePoint0 + e] = mesh_.nodes[ids[kEdgePoint0 + e]];
-    }
     for (int fc = 0; fc < 6; ++fc) {
       if (!(entry.face_point_mask >> fc & 1)) continue;
       const auto& fe = entry.face_point_edges[fc];

@@ -125,7 +125,7 @@ std::vector<std::array<int, 8>> cube_rotations() {
   return group;
 }
 
-TEST(CaseTable, CoversEveryConfigurationAndSaddleOutcome) {
+TEST(CaseTable, CoversEveryConfigurationAndFaceChoice) {
   std::size_t entries = 0;
   for_each_entry([&](std::uint8_t, std::uint8_t) { ++entries; });
   EXPECT_EQ(entries, case_entry_count());
@@ -257,8 +257,8 @@ TEST(CaseTable, EveryConfigurationFillsItsRegionForRandomVertexValues) {
   EXPECT_EQ(unresolved, 0u);
 }
 
-// A face shared by two cubes is tessellated from its four vertex flags and its saddle outcome
-// alone, so both cubes see the same polygons, in opposite orientation.
+// A face shared by two cubes is tessellated from its four vertex flags and its choice (saddle
+// outcome or trapezoid) alone, so both cubes see the same polygons, in opposite orientation.
 TEST(CaseTable, SharedFacesAreTessellatedIdenticallyFromBothSides) {
   // Map a local point of the cube at `origin` to a global grid entity.
   using Key = std::tuple<char, int, int, int, int>;
