@@ -14,10 +14,12 @@
 
 namespace naris::mve {
 
-int edge_between(int a, int b) {
+std::uint16_t crossing_edges(std::uint8_t config) {
+  std::uint16_t mask = 0;
   for (int e = 0; e < 12; ++e)
-    if ((kEdge[e][0] == a && kEdge[e][1] == b) || (kEdge[e][0] == b && kEdge[e][1] == a)) return e;
-  return -1;
+    if ((config >> kEdge[e][0] & 1) != (config >> kEdge[e][1] & 1))
+      mask |= static_cast<std::uint16_t>(1u << e);
+  return mask;
 }
 
 std::uint8_t edge_faces(std::uint8_t config) {
@@ -76,7 +78,7 @@ void tessellate_face(std::uint8_t config, std::uint8_t choices, int f, CaseEntry
   int count = 0;
   for (int i = 0; i < 4; ++i) count += in[i] = config >> c[i] & 1;
   auto iso = [&](int i) {  // isopoint on the face edge from c[i] to c[i+1]
-    return kEdgePoint0 + edge_between(c[i % 4], c[(i + 1) % 4]);
+    return kEdgePoint0 + kFaceEdge[f][i % 4];
   };
   auto v = [&](int i) { return c[i % 4]; };
   auto& out = entry.face_polygons[f];
@@ -291,6 +293,7 @@ class FewestCells {
   struct Move {
     std::size_t base;  // front polygon the cell stands on
     int apex;
+    int closed = 0;  // front polygons its cell closes besides its base (closes())
   };
 
   // An oriented polygon rotated to start at its smallest id: then two polygons are the same
@@ -385,8 +388,9 @@ class FewestCells {
   void moves_closing(std::size_t i, std::vector<Move>& moves, std::size_t limit) {
     moves.clear();
     const Polygon& f = front_[i];
-    auto consider = [&](const Move& m) {
-      if (closes(m) >= 0 && positive(cone(front_[m.base], m.apex))) moves.push_back(m);
+    auto consider = [&](Move m) {
+      m.closed = closes(m);
+      if (m.closed >= 0 && positive(cone(front_[m.base], m.apex))) moves.push_back(m);
       return moves.size() < limit;
     };
     for (int x : points_)
@@ -424,7 +428,7 @@ class FewestCells {
     }
     // Moves that close the most first: good fills are found early.
     std::vector<std::pair<int, std::size_t>> order;
-    for (std::size_t k = 0; k < fewest.size(); ++k) order.push_back({-closes(fewest[k]), k});
+    for (std::size_t k = 0; k < fewest.size(); ++k) order.push_back({-fewest[k].closed, k});
     std::sort(order.begin(), order.end());
     std::vector<Polygon> next;
     for (const auto& [closed, k] : order) {
@@ -486,9 +490,7 @@ std::vector<Tessellation> fewest_cell_fills(const std::vector<Points>& samples,
 CaseEntry build_entry(std::uint8_t config, std::uint8_t face_choices, const Sampler& sampler) {
   CaseEntry entry;
   for (int f = 0; f < 6; ++f) tessellate_face(config, face_choices, f, entry);
-  for (int e = 0; e < 12; ++e)
-    if ((config >> kEdge[e][0] & 1) != (config >> kEdge[e][1] & 1))
-      entry.edge_mask |= static_cast<std::uint16_t>(1u << e);
+  entry.edge_mask = crossing_edges(config);
 
   // Components: points joined by a common face polygon belong together.
   UnionFind uf;
@@ -580,9 +582,8 @@ CaseEntry build_entry(std::uint8_t config, std::uint8_t face_choices, const Samp
                      tess))
         continue;
       int failures = 0;
-      Points pts;
-      for (const auto& t : sampler.params) {
-        sample_points(entry, t, pts);
+      for (const Points& sample : samples) {
+        Points pts = sample;  // place_and_measure writes the private points
         if (!(place_and_measure(tess, pts, false).volume6 > 6e-14)) ++failures;  // 6× volume
       }
       ranked.push_back({{failures, static_cast<int>(tess.cells.size())}, std::move(tess)});
@@ -644,14 +645,6 @@ Table& table() {
 
 const CaseEntry& case_entry(std::uint8_t config, std::uint8_t choices) {
   return table().at(config, static_cast<std::uint8_t>(choices & choice_faces(config)));
-}
-
-std::size_t case_entry_count() {
-  std::size_t distinct = 0;
-  for (int config = 0; config < 256; ++config)
-    distinct +=
-        std::size_t{1} << __builtin_popcount(choice_faces(static_cast<std::uint8_t>(config)));
-  return distinct;
 }
 
 }  // namespace naris::mve

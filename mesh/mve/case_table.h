@@ -39,6 +39,18 @@ inline constexpr std::array<std::array<int, 2>, 12> kEdge = {{{0, 1},
 // Faces −x, +x, −y, +y, −z, +z, each as a vertex cycle counter-clockwise seen from outside.
 inline constexpr std::array<std::array<int, 4>, 6> kFace = {
     {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}}};
+// kFaceEdge[f][i]: the edge from kFace[f][i] to kFace[f][i + 1].
+inline constexpr std::array<std::array<int, 4>, 6> kFaceEdge = [] {
+  std::array<std::array<int, 4>, 6> t{};
+  for (int f = 0; f < 6; ++f)
+    for (int i = 0; i < 4; ++i)
+      for (int e = 0; e < 12; ++e) {
+        const int a = kFace[f][i], b = kFace[f][(i + 1) % 4];
+        if ((kEdge[e][0] == a && kEdge[e][1] == b) || (kEdge[e][0] == b && kEdge[e][1] == a))
+          t[f][i] = e;
+      }
+  return t;
+}();
 
 // A triangle or quadrilateral of local point ids, counter-clockwise seen from outside the
 // inside region.
@@ -109,10 +121,7 @@ std::uint8_t choice_faces(std::uint8_t config);
 // stays a trapezoid. Other bits are ignored.
 const CaseEntry& case_entry(std::uint8_t config, std::uint8_t choices);
 
-// Number of distinct (configuration, face choices) entries.
-std::size_t case_entry_count();
-
-// Edge id joining two cube vertices, or -1.
-int edge_between(int a, int b);
+// Edges whose ends lie on opposite sides (bit e for edge e): those carrying an isopoint.
+std::uint16_t crossing_edges(std::uint8_t config);
 
 }  // namespace naris::mve

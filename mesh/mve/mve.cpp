@@ -378,8 +378,9 @@ class Mesher {
       ids[v] = vertex_node(i + kCorner[v][0], j + kCorner[v][1], kCorner[v][2]);
       x_[v] = mesh_.nodes[ids[v]];
     }
+    const std::uint16_t crossed = crossing_edges(static_cast<std::uint8_t>(config));
     for (int e = 0; e < 12; ++e) {
-      if ((config >> kEdge[e][0] & 1) == (config >> kEdge[e][1] & 1)) continue;
+      if (!(crossed >> e & 1)) continue;
       ids[kEdgePoint0 + e] = edge_node(i, j, e);
       x_[kEdgePoint0 + e] = mesh_.nodes[ids[kEdgePoint0 + e]];
     }
@@ -397,9 +398,8 @@ class Mesher {
       const auto& c = kFace[fc];
       if (edge >> fc & 1) {
         bool midpoints = true;
-        for (int n = 0; n < 4; ++n) {
-          const int e = edge_between(c[n], c[(n + 1) % 4]);
-          if ((config >> kEdge[e][0] & 1) == (config >> kEdge[e][1] & 1)) continue;
+        for (int e : kFaceEdge[fc]) {
+          if (!(crossed >> e & 1)) continue;
           const int axis = e / 4;
           midpoints = midpoints &&
                       x_[kEdgePoint0 + e][axis] - corner0[axis] - kCorner[kEdge[e][0]][axis] == 0.5;

@@ -45,6 +45,10 @@ int main(int argc, char** argv) {
   const int n = numbers.empty() ? 10000 : numbers.front();
   std::vector<int> resolutions(numbers.begin() + (numbers.empty() ? 0 : 1), numbers.end());
   if (resolutions.empty()) resolutions = {14, 20, 28};
+  auto pui = [](double stokes) {  // the correlation at θ = π/2
+    const double q = stokes / 0.171;
+    return 1.0 - std::pow(1.0 + std::pow(q, 0.452 * q + 2.242), -1.0);
+  };
   // Lengths in units of D (read as millimetres), the velocity in units of Ū (read as m/s).
   const double a = 0.5, bend = 2.85, re = 1000.0;
   std::printf(
@@ -85,10 +89,6 @@ int main(int argc, char** argv) {
         ++counts[static_cast<int>(
             track(flow, {x, std::nullopt, flow.locate(x)}, kind, o, {}, false).fate)];
       const double eta = counts[static_cast<int>(Fate::wall)] / double(n);
-      auto pui = [](double stokes) {
-        const double q = stokes / 0.171;
-        return 1.0 - std::pow(1.0 + std::pow(q, 0.452 * q + 2.242), -1.0);
-      };
       std::printf("| %d | %zu | %.1f | %.3f | %.3f | %+.3f | %.3f | %+.3f | %d | %d | %.1f |\n",
                   across, m.cell_count(), stk, eta, pui(stk), eta - pui(stk), pui(0.5 * stk),
                   eta - pui(0.5 * stk), n, counts[static_cast<int>(Fate::lost)], clock.seconds());
