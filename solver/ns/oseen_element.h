@@ -134,7 +134,16 @@ void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
   std::array<fem::MappedValues<N>, 27> mapped;
   for (std::size_t q = 0; q < nq; ++q) mapped[q] = fem::map_to_cell<E>(X, table.shapes[q]);
   const bool newton = linearization == Linearization::newton;
-  out.K.setZero();
+  // The blocks of K summed over the points in compact form and interleaved once at the end:
+  // rank-one updates of small dense matrices, not scattered updates of K at every point.
+  Eigen::Matrix<double, N, N> momentum = Eigen::Matrix<double, N, N>::Zero();  // per component
+  Eigen::Matrix<double, N, N> pressure_pressure = Eigen::Matrix<double, N, N>::Zero();
+  Eigen::Matrix<double, 3 * N, 3 * N> grad_div = Eigen::Matrix<double, 3 * N, 3 * N>::Zero();
+  std::array<Eigen::Matrix<double, N, N>, 3> velocity_pressure, pressure_velocity;
+  for (int c = 0; c < 3; ++c) {
+    velocity_pressure[static_cast<std::size_t>(c)].setZero();
+    pressure_velocity[static_cast<std::size_t>(c)].setZero();
+  }
   out.F.setZero();
   if (newton) out.newton.setZero();
   for (std::size_t q = 0; q < nq; ++q) {
@@ -150,21 +159,22 @@ void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
     const double tau_c = 3.0 / (tau_m * metric.trace());
     const Eigen::Matrix<double, N, 1> adv = G * aq;  // (a·∇)N_i
     const Eigen::Matrix<double, N, N> diffusion = G * G.transpose();
-    for (int i = 0; i < N; ++i) {
-      const double supg_i = tau_m * adv[i];
-      for (int j = 0; j < N; ++j) {
-        const double momentum = w * (nu * diffusion(i, j) + Nv[i] * adv[j] + supg_i * adv[j]);
-        for (int c = 0; c < 3; ++c) {
-          out.K(4 * i + c, 4 * j + c) += momentum;
-          for (int d = 0; d < 3; ++d) out.K(4 * i + c, 4 * j + d) += w * tau_c * G(i, c) * G(j, d);
-          out.K(4 * i + c, 4 * j + 3) += w * (-G(i, c) * Nv[j] + supg_i * G(j, c));
-          out.K(4 * i + 3, 4 * j + c) += w * (Nv[i] * G(j, c) + tau_m * G(i, c) * adv[j]);
-        }
-        out.K(4 * i + 3, 4 * j + 3) += w * tau_m * diffusion(i, j);
-      }
-      for (int c = 0; c < 3; ++c) out.F[4 * i + c] += w * (Nv[i] * f[c] + supg_i * f_stab[c]);
-      out.F[4 * i + 3] += w * tau_m * G.row(i).dot(f_stab);
+    const Eigen::Matrix<double, N, 1> weighted = w * Nv, supg = (w * tau_m) * adv;
+    momentum.noalias() += (w * nu) * diffusion + (weighted + supg) * adv.transpose();
+    pressure_pressure.noalias() += (w * tau_m) * diffusion;
+    // Row and column 3i + c of the grad-div block: G(i, c).
+    const Eigen::Matrix<double, N, 3, Eigen::RowMajor> by_node = G;
+    const auto g = Eigen::Map<const Eigen::Matrix<double, 3 * N, 1>>(by_node.data());
+    grad_div.noalias() += (w * tau_c) * g * g.transpose();
+    for (int c = 0; c < 3; ++c) {
+      const auto Gc = G.col(c);
+      velocity_pressure[static_cast<std::size_t>(c)].noalias() +=
+          -Gc * weighted.transpose() + supg * Gc.transpose();
+      pressure_velocity[static_cast<std::size_t>(c)].noalias() +=
+          weighted * Gc.transpose() + ((w * tau_m) * Gc) * adv.transpose();
+      for (int i = 0; i < N; ++i) out.F[4 * i + c] += weighted[i] * f[c] + supg[i] * f_stab[c];
     }
+    for (int i = 0; i < N; ++i) out.F[4 * i + 3] += w * tau_m * G.row(i).dot(f_stab);
     if (!newton) continue;
     const Eigen::Matrix3d grad_u = a.transpose() * G;  // (c, d) = ∂u_c/∂x_d
     const Eigen::Vector3d r = grad_u * aq + G.transpose() * p - f_stab;
@@ -189,6 +199,18 @@ void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
         out.newton.template block<4, 3>(4 * i, 4 * j) += (w * Nv[j]) * row_block;
     }
   }
+  for (int j = 0; j < N; ++j)
+    for (int i = 0; i < N; ++i) {
+      for (int d = 0; d < 3; ++d)
+        for (int c = 0; c < 3; ++c)
+          out.K(4 * i + c, 4 * j + d) =
+              grad_div(3 * i + c, 3 * j + d) + (c == d ? momentum(i, j) : 0.0);
+      for (int c = 0; c < 3; ++c) {
+        out.K(4 * i + c, 4 * j + 3) = velocity_pressure[static_cast<std::size_t>(c)](i, j);
+        out.K(4 * i + 3, 4 * j + c) = pressure_velocity[static_cast<std::size_t>(c)](i, j);
+      }
+      out.K(4 * i + 3, 4 * j + 3) = pressure_pressure(i, j);
+    }
   if (linearization == Linearization::picard) return;
   Eigen::Matrix<double, 4 * N, 1> state;
   for (int i = 0; i < N; ++i) {
