@@ -36,5 +36,8 @@ void add_segment_command(CLI::App& app);
 
 // PETSc options (a `petsc` setting) into PETSc's database; -log_view begins the event log.
 void insert_petsc_options(const std::string& options);
+// One line per option in PETSc's database that nothing read: misspelt, or meant for a solver
+// the run did not set up. The stage's result stands; the line says which setting had no effect.
+std::string unused_petsc_options();
 
 }  // namespace naris::app

@@ -229,7 +229,8 @@ void plan_flow_stages(const YAML::Node& root, const std::string& where, const fs
                            petsc::Session session;
                            insert_petsc_options(petsc_options);
                            return airflow::format_airflow_summary(*job,
-                                                                  airflow::run_airflow_job(*job));
+                                                                  airflow::run_airflow_job(*job)) +
+                                  unused_petsc_options();
                          }});
   const fs::path solution = job->output / "solution.h5";
   fs::path crossings;

@@ -22,6 +22,21 @@ void insert_petsc_options(const std::string& options) {
   if (log_view) petsc::check(PetscLogDefaultBegin(), "PetscLogDefaultBegin");
 }
 
+std::string unused_petsc_options() {
+  PetscInt count = 0;
+  char **names = nullptr, **values = nullptr;
+  petsc::check(PetscOptionsLeftGet(nullptr, &count, &names, &values), "PetscOptionsLeftGet");
+  std::string lines;
+  for (PetscInt i = 0; i < count; ++i)
+    lines += fmt::format(
+        "\n  warning   PETSc option -{}{}{} was never used (misspelt, or for a "
+        "solver this run did not set up)",
+        names[i], values[i] ? " " : "", values[i] ? values[i] : "");
+  petsc::check(PetscOptionsLeftRestore(nullptr, &count, &names, &values),
+               "PetscOptionsLeftRestore");
+  return lines;
+}
+
 void add_solve_command(CLI::App& app) {
   auto [o, cmd] = add_stage<SolveSettings>(
       app, "solve",
@@ -43,7 +58,7 @@ void add_solve_command(CLI::App& app) {
     insert_petsc_options(o->petsc);
     if (session.size() > 1) log_line(fmt::format("naris solve: {} MPI ranks", session.size()));
     const airflow::AirflowResult r = airflow::run_airflow_job(job);
-    log_line(airflow::format_airflow_summary(job, r));
+    log_line(airflow::format_airflow_summary(job, r) + unused_petsc_options());
   });
 }
 

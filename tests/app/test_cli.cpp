@@ -564,8 +564,11 @@ TEST_F(Cli, SolvesTheFlowThroughACutBall) {
   const fs::path mesh = dir_ / "out" / "mesh.h5";
   ASSERT_NO_FATAL_FAILURE(mesh_cut_ball(mesh));
   const fs::path solution = dir_ / "out" / "solution";
-  CliRun r = naris("solve " + mesh.string() + " --re 20 -o " + solution.string());
+  // A PETSc option the solve reads is taken silently.
+  CliRun r = naris("solve " + mesh.string() + " --re 20 --petsc \"-ns_ksp_type gmres\" -o " +
+                   solution.string());
   ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("never used"), std::string::npos) << r.err;
   for (const char* f : {"solution.h5", "solution.xdmf", "solution.vtu", "summary.json",
                         "residuals.csv", "checkpoint.h5"})
     EXPECT_TRUE(fs::exists(solution / f)) << f;
@@ -588,9 +591,13 @@ TEST_F(Cli, SolvesTheFlowThroughACutBall) {
               1e-5 * summary(solution, "max_speed_m_s"));
   // A constant expression is the uniform profile: the same answer, and the summary says which.
   const fs::path typed = dir_ / "out" / "typed";
-  r = naris("solve " + mesh.string() + " --re 20 --inlet-expression \"3 + 0*x*r\" -o " +
+  // A misspelt PETSc option changes nothing, and the solve says so.
+  r = naris("solve " + mesh.string() +
+            " --re 20 --inlet-expression \"3 + 0*x*r\" --petsc \"-ns_ksp_typo gmres\" -o " +
             typed.string());
   ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("PETSc option -ns_ksp_typo gmres was never used"), std::string::npos)
+      << r.err;
   EXPECT_NEAR(summary(typed, "pressure_drop_pa"), direct, 1e-5 * direct);
   std::ifstream file(typed / "summary.json");
   const std::string text((std::istreambuf_iterator<char>(file)), {});
