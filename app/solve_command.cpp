@@ -23,17 +23,12 @@ void insert_petsc_options(const std::string& options) {
 }
 
 std::string unused_petsc_options() {
-  PetscInt count = 0;
-  char **names = nullptr, **values = nullptr;
-  petsc::check(PetscOptionsLeftGet(nullptr, &count, &names, &values), "PetscOptionsLeftGet");
   std::string lines;
-  for (PetscInt i = 0; i < count; ++i)
+  for (const std::string& option : petsc::unused_options())
     lines += fmt::format(
-        "\n  warning   PETSc option -{}{}{} was never used (misspelt, or for a "
-        "solver this run did not set up)",
-        names[i], values[i] ? " " : "", values[i] ? values[i] : "");
-  petsc::check(PetscOptionsLeftRestore(nullptr, &count, &names, &values),
-               "PetscOptionsLeftRestore");
+        "\n  warning   PETSc option {} was never used (misspelt, or for a solver this run did "
+        "not set up)",
+        option);
   return lines;
 }
 

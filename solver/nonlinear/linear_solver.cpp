@@ -63,12 +63,8 @@ void LinearSolver::set_default_preconditioner(MPI_Comm comm, const std::string& 
   check(PCASMSetOverlap(pc, 1), "PCASMSetOverlap");
   for (const auto& [name, value] :
        {std::pair{"sub_pc_type", "ilu"}, std::pair{"sub_pc_factor_levels", "1"},
-        std::pair{"sub_pc_factor_mat_ordering_type", "rcm"}}) {
-    const std::string key = "-" + prefix + name;
-    PetscBool set = PETSC_FALSE;
-    check(PetscOptionsHasName(nullptr, nullptr, key.c_str(), &set), "PetscOptionsHasName");
-    if (!set) check(PetscOptionsSetValue(nullptr, key.c_str(), value), "PetscOptionsSetValue");
-  }
+        std::pair{"sub_pc_factor_mat_ordering_type", "rcm"}})
+    petsc::set_default_option("-" + prefix + name, value);
 }
 
 PetscErrorCode LinearSolver::monitor(KSP solver, PetscInt it, PetscReal norm, void* context) {

@@ -4,7 +4,9 @@
 // naris::Error carrying PETSc's message.
 #include <petscksp.h>
 
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace naris::petsc {
 
@@ -25,6 +27,14 @@ class Session {
  private:
   bool owns_ = false;
 };
+
+// A default of naris's into PETSc's options database, unless the user gave the option: the
+// command line still overrides it. Such defaults are left out of unused_options().
+void set_default_option(const std::string& key, const char* value);
+
+// The options in the database that nothing has read so far (as "-name value"), leaving out
+// naris's own defaults and the options PETSc reads only at PetscFinalize.
+std::vector<std::string> unused_options();
 
 // naris's own work as an event of PETSc's profile (`-log_view`), beside PETSc's factorizations
 // and Krylov iterations: the time between construction and destruction, under `name`

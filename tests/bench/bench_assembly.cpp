@@ -21,7 +21,7 @@ using namespace naris;
 
 namespace {
 
-// A smooth swirl over the mesh's bounding box, of unit speed, and its gradient.
+// A smooth swirl over the mesh's bounding box, of unit amplitude, and its gradient.
 struct Swirl {
   Eigen::Vector3d lo, scale;
   Eigen::Vector3d velocity(const Eigen::Vector3d& x) const {
@@ -43,7 +43,6 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Microseconds per cell of the element kernel over every cell of one type, best of `repeat`.
 // The advection and its gradient at every node, computed once.
 struct NodalField {
   std::vector<Eigen::Vector3d> velocity;
@@ -51,6 +50,7 @@ struct NodalField {
   std::vector<double> pressure;
 };
 
+// Microseconds per cell of the element kernel over every cell of one type, best of `repeat`.
 template <class E, class Cells>
 double kernel_microseconds(const HybridMesh& mesh, const Cells& cells, const NodalField& field,
                            double nu, ns::Linearization linearization, int repeat) {
@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
     field.pressure.push_back(x.x());
   }
   std::printf("\nElement kernel (oseen_element), µs per cell, best of %d\n", repeat);
-  std::printf("%-14s %10s %10s\n", "cell", "Picard", "Newton");
+  std::printf("%-14s %10s %10s\n", "cell", "Picard+R", "Newton");
   using ns::Linearization;
   const auto kernel_row = [&](const char* name, auto picard, auto newton) {
     std::printf("%-14s %10.3f %10.3f\n", name, picard, newton);
@@ -146,7 +146,7 @@ int main(int argc, char** argv) {
                          MATBAIJ);
   std::printf("\nOseenSystem::assemble, median of %d\n", repeat);
   std::printf("%-14s %10s %14s\n", "linearization", "seconds", "cells per s");
-  for (const auto& [name, linearization] : {std::pair{"Picard", Linearization::picard_residual},
+  for (const auto& [name, linearization] : {std::pair{"Picard+R", Linearization::picard_residual},
                                             std::pair{"Newton", Linearization::newton}}) {
     std::vector<double> seconds;
     for (int r = 0; r < repeat; ++r) {
