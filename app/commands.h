@@ -5,6 +5,8 @@
 #include <string>
 #include <utility>
 
+#include "solver/airflow/airflow_job.h"
+
 namespace naris::app {
 
 // A subcommand whose options live in a shared Options object: CLI11 fills it while parsing and
@@ -36,8 +38,8 @@ void add_segment_command(CLI::App& app);
 
 // PETSc options (a `petsc` setting) into PETSc's database; -log_view begins the event log.
 void insert_petsc_options(const std::string& options);
-// One line per option in PETSc's database that nothing read: misspelt, or meant for a solver
-// the run did not set up. The stage's result stands; the line says which setting had no effect.
-std::string unused_petsc_options();
+// The airflow job run, and its summary followed by one warning per PETSc option that nothing
+// read (misspelt, or for a solver the run did not set up): known only once the solve has run.
+std::string solve_and_summarize(const airflow::AirflowJob& job);
 
 }  // namespace naris::app

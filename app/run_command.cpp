@@ -228,10 +228,7 @@ void plan_flow_stages(const YAML::Node& root, const std::string& where, const fs
                          [job, petsc_options = solve.petsc] {
                            petsc::Session session;
                            insert_petsc_options(petsc_options);
-                           // The solve first: only then is it known which options it read.
-                           const airflow::AirflowResult result = airflow::run_airflow_job(*job);
-                           return airflow::format_airflow_summary(*job, result) +
-                                  unused_petsc_options();
+                           return solve_and_summarize(*job);
                          }});
   const fs::path solution = job->output / "solution.h5";
   fs::path crossings;

@@ -22,14 +22,14 @@ void insert_petsc_options(const std::string& options) {
   if (log_view) petsc::check(PetscLogDefaultBegin(), "PetscLogDefaultBegin");
 }
 
-std::string unused_petsc_options() {
-  std::string lines;
+std::string solve_and_summarize(const airflow::AirflowJob& job) {
+  std::string summary = airflow::format_airflow_summary(job, airflow::run_airflow_job(job));
   for (const std::string& option : petsc::unused_options())
-    lines += fmt::format(
+    summary += fmt::format(
         "\n  warning   PETSc option {} was never used (misspelt, or for a solver this run did "
         "not set up)",
         option);
-  return lines;
+  return summary;
 }
 
 void add_solve_command(CLI::App& app) {
@@ -52,8 +52,7 @@ void add_solve_command(CLI::App& app) {
     if (session.rank() > 0) set_verbosity(Verbosity::quiet);
     insert_petsc_options(o->petsc);
     if (session.size() > 1) log_line(fmt::format("naris solve: {} MPI ranks", session.size()));
-    const airflow::AirflowResult r = airflow::run_airflow_job(job);
-    log_line(airflow::format_airflow_summary(job, r) + unused_petsc_options());
+    log_line(solve_and_summarize(job));
   });
 }
 

@@ -140,10 +140,8 @@ void oseen_element(const Eigen::Matrix<double, E::nodes, 3>& X,
   Eigen::Matrix<double, N, N> pressure_pressure = Eigen::Matrix<double, N, N>::Zero();
   Eigen::Matrix<double, 3 * N, 3 * N> grad_div = Eigen::Matrix<double, 3 * N, 3 * N>::Zero();
   std::array<Eigen::Matrix<double, N, N>, 3> velocity_pressure, pressure_velocity;
-  for (int c = 0; c < 3; ++c) {
-    velocity_pressure[static_cast<std::size_t>(c)].setZero();
-    pressure_velocity[static_cast<std::size_t>(c)].setZero();
-  }
+  velocity_pressure.fill(Eigen::Matrix<double, N, N>::Zero());
+  pressure_velocity.fill(Eigen::Matrix<double, N, N>::Zero());
   out.F.setZero();
   if (newton) out.newton.setZero();
   for (std::size_t q = 0; q < nq; ++q) {
