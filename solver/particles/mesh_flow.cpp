@@ -313,8 +313,9 @@ int MeshFlow::locate(const Vec3& x) const {
   std::array<int, 3> b{};
   for (int a = 0; a < 3; ++a) {
     const double s = (x[a] - lo_[a]) / bucket_;
-    if (!(s >= 0.0) || s >= dims_[a]) return -1;
-    b[a] = std::min(static_cast<int>(s), dims_[a] - 1);
+    // A point on a face of the mesh's box may lie a rounding error outside it: the cells decide.
+    if (!(s >= -1e-6) || s >= dims_[a]) return -1;
+    b[a] = std::clamp(static_cast<int>(s), 0, dims_[a] - 1);
   }
   const std::size_t id =
       static_cast<std::size_t>(b[0]) +

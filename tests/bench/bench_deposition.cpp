@@ -4,11 +4,14 @@
 // profile, flux-weighted particles, Stokes drag. Stk = ρ_p d² C_c Ū / (9 μ D) = τ Ū / (D/2).
 // Prints one row per resolution and Stokes number, with the correlation read with this Stk and
 // with τŪ/D (VERIFICATION.md's convention, half of it). With --uniform-inlet the air enters the
-// bend with a flat profile instead (a bend fed by a short straight tube). --diameter sets the
+// bend with a flat profile instead (a bend fed by a short straight tube). With --inlet-tube L a
+// straight tube of L diameters feeds the bend, the developed profile entering the tube, and only
+// deposits in the bend count. --diameter sets the
 // particles' diameter in µm (2 by default: d/D = 0.002 as in Pui's tubes; the density follows
 // from Stk), in a tube 1 mm across, since deposition reaches d/2 from the wall.
 //
-//   bench_deposition [--uniform-inlet] [--diameter µm] [particles = 10000] [cells across D ...]
+//   bench_deposition [--uniform-inlet] [--inlet-tube L] [--diameter µm] [particles = 10000]
+//                    [cells across D ...]
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -31,7 +34,7 @@ int main(int argc, char** argv) {
   petsc::Session session;
   set_verbosity(Verbosity::quiet);
   bool uniform = false;
-  double diameter = 2e-6;
+  double diameter = 2e-6, inlet_tube = 0.0;
   std::vector<int> numbers;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -39,6 +42,8 @@ int main(int argc, char** argv) {
       uniform = true;
     else if (arg == "--diameter" && i + 1 < argc)
       diameter = std::atof(argv[++i]) * 1e-6;
+    else if (arg == "--inlet-tube" && i + 1 < argc)
+      inlet_tube = std::atof(argv[++i]);
     else
       numbers.push_back(std::atoi(argv[i]));
   }
@@ -59,9 +64,13 @@ int main(int argc, char** argv) {
     mve::MveOptions options;
     options.side_patch[0] = "outlet";
     options.side_patch[2] = "inlet";
-    auto s = [&](const Vec3& x) { return std::hypot(std::hypot(x[0], x[1]) - bend, x[2]); };
+    // The torus for y ≥ 0; below, the straight tube that feeds it along y.
+    auto s = [&](const Vec3& x) {
+      return x[1] >= 0.0 ? std::hypot(std::hypot(x[0], x[1]) - bend, x[2])
+                         : std::hypot(x[0] - bend, x[2]);
+    };
     const HybridMesh m =
-        testing::mve_mesh_box([&](const Vec3& x) { return a - s(x); }, {0.0, 0.0, -0.6},
+        testing::mve_mesh_box([&](const Vec3& x) { return a - s(x); }, {0.0, -inlet_tube, -0.6},
                               {3.5, 3.5, 0.6}, 1.0 / across, options);
     const ns::DirichletConditions bc = ns::airflow_conditions(
         m, uniform ? ns::InletProfile::uniform : ns::InletProfile::developed, 1.0);
@@ -84,11 +93,13 @@ int main(int argc, char** argv) {
       const double d = diameter, cc = cunningham_factor(d, o.air.mean_free_path);
       const ParticleKind kind{d, 18.0 * o.air.viscosity * (stk * a * 1e-3) / (d * d * cc)};
       Stopwatch clock;
-      int counts[kFates] = {};
-      for (const Vec3& x : seeds.points)
-        ++counts[static_cast<int>(
-            track(flow, {x, std::nullopt, flow.locate(x)}, kind, o, {}, false).fate)];
-      const double eta = counts[static_cast<int>(Fate::wall)] / double(n);
+      int counts[kFates] = {}, in_bend = 0;
+      for (const Vec3& x : seeds.points) {
+        const ParticleResult r = track(flow, {x, std::nullopt, flow.locate(x)}, kind, o, {}, false);
+        ++counts[static_cast<int>(r.fate)];
+        in_bend += r.fate == Fate::wall && r.contact[1] >= 0.0;
+      }
+      const double eta = in_bend / double(n);
       std::printf("| %d | %zu | %.1f | %.3f | %.3f | %+.3f | %.3f | %+.3f | %d | %d | %.1f |\n",
                   across, m.cell_count(), stk, eta, pui(stk), eta - pui(stk), pui(0.5 * stk),
                   eta - pui(0.5 * stk), n, counts[static_cast<int>(Fate::lost)], clock.seconds());
