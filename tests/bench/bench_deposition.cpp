@@ -9,9 +9,14 @@
 // deposits in the bend count. --diameter sets the
 // particles' diameter in µm (2 by default: d/D = 0.002 as in Pui's tubes; the density follows
 // from Stk), in a tube 1 mm across, since deposition reaches d/2 from the wall.
+// For the comparison with another solver (tests/bench/bend_openfoam.sh): --binary meshes the
+// tube's 0/1 indicator, as from a labelmap (isopoints at edge midpoints: a chamfered wall
+// whose cells OpenFOAM accepts, where the signed distance leaves slivers); --write-msh FILE
+// writes the (last) mesh in Gmsh 2.2; --field FILE traces through the velocities it lists
+// (one node per line, in units of Ū, in the mesh's node order) instead of solving.
 //
-//   bench_deposition [--uniform-inlet] [--inlet-tube L] [--diameter µm] [particles = 10000]
-//                    [cells across D ...]
+//   bench_deposition [--uniform-inlet] [--inlet-tube L] [--diameter µm] [--binary]
+//                    [--write-msh FILE] [--field FILE] [particles = 10000] [cells across D ...]
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +24,7 @@
 #include <vector>
 
 #include "core/log.h"
+#include "mesh/io/write_gmsh.h"
 #include "solver/nonlinear/navier_stokes_solver.h"
 #include "solver/ns/boundary_conditions.h"
 #include "solver/parallel/petsc.h"
@@ -30,18 +36,40 @@
 using namespace naris;
 using namespace naris::particles;
 
+namespace {
+
+// One velocity per line, three numbers each.
+std::vector<Vec3> read_velocities(const std::string& path) {
+  std::vector<Vec3> u;
+  if (std::FILE* f = std::fopen(path.c_str(), "r")) {
+    Vec3 v;
+    while (std::fscanf(f, "%lf %lf %lf", &v[0], &v[1], &v[2]) == 3) u.push_back(v);
+    std::fclose(f);
+  }
+  return u;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   petsc::Session session;
   set_verbosity(Verbosity::quiet);
-  bool uniform = false;
+  bool uniform = false, binary = false;
   double diameter = 2e-6, inlet_tube = 0.0;
+  std::string write_msh, field_file;
   std::vector<int> numbers;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--uniform-inlet")
       uniform = true;
+    else if (arg == "--binary")
+      binary = true;
     else if (arg == "--diameter" && i + 1 < argc)
       diameter = std::atof(argv[++i]) * 1e-6;
+    else if (arg == "--write-msh" && i + 1 < argc)
+      write_msh = argv[++i];
+    else if (arg == "--field" && i + 1 < argc)
+      field_file = argv[++i];
     else if (arg == "--inlet-tube" && i + 1 < argc)
       inlet_tube = std::atof(argv[++i]);
     else
@@ -69,20 +97,30 @@ int main(int argc, char** argv) {
       return x[1] >= 0.0 ? std::hypot(std::hypot(x[0], x[1]) - bend, x[2])
                          : std::hypot(x[0] - bend, x[2]);
     };
-    const HybridMesh m =
-        testing::mve_mesh_box([&](const Vec3& x) { return a - s(x); }, {0.0, -inlet_tube, -0.6},
-                              {3.5, 3.5, 0.6}, 1.0 / across, options);
+    const HybridMesh m = testing::mve_mesh_box(
+        [&](const Vec3& x) { return binary ? (s(x) < a ? 0.5 : -0.5) : a - s(x); },
+        {0.0, -inlet_tube, -0.6}, {3.5, 3.5, 0.6}, 1.0 / across, options);
+    if (!write_msh.empty()) write_gmsh22(m, write_msh);
     const ns::DirichletConditions bc = ns::airflow_conditions(
         m, uniform ? ns::InletProfile::uniform : ns::InletProfile::developed, 1.0);
     ns::FlowField field;
-    for (double step : {100.0, 300.0, 600.0, re}) {
-      nonlinear::NonlinearReport report;
-      const ns::FlowField earlier = field;
-      field = nonlinear::solve_navier_stokes(m, ns::FlowProblem{step, {}, bc}, {}, &report,
-                                             step == 100.0 ? nullptr : &earlier);
-      if (!report.converged) {
-        std::fprintf(stderr, "the bend's flow did not converge at Re %g\n", step);
+    if (!field_file.empty()) {
+      field.velocity = read_velocities(field_file);
+      if (field.velocity.size() != m.nodes.size()) {
+        std::fprintf(stderr, "%s lists %zu velocities for a mesh of %zu nodes\n",
+                     field_file.c_str(), field.velocity.size(), m.nodes.size());
         return 1;
+      }
+    } else {
+      for (double step : {100.0, 300.0, 600.0, re}) {
+        nonlinear::NonlinearReport report;
+        const ns::FlowField earlier = field;
+        field = nonlinear::solve_navier_stokes(m, ns::FlowProblem{step, {}, bc}, {}, &report,
+                                               step == 100.0 ? nullptr : &earlier);
+        if (!report.converged) {
+          std::fprintf(stderr, "the bend's flow did not converge at Re %g\n", step);
+          return 1;
+        }
       }
     }
     const MeshFlow flow(m, field.velocity, {m.patch_id("inlet"), m.patch_id("outlet")});

@@ -8,6 +8,9 @@
 # foam_total_time (s), foam_memory (peak, MB), foam_converged and foam_residuals (its own
 # convergence report).
 # Usage: simplefoam.sh MESH_H5 U_IN WORK [LABEL]
+# NARIS_FOAM_INLET_U: the inlet's entry of 0/U instead (e.g. a developed profile);
+# NARIS_FOAM_CONVERGE=1: run to SIMPLE's residualControl and write the fields there instead of
+# stopping once Δp has settled.
 set -euo pipefail
 mesh=$1
 u_in=$2
@@ -76,12 +79,15 @@ cat > "$case/constant/turbulenceProperties" <<'DICT'
 FoamFile { version 2.0; format ascii; class dictionary; object turbulenceProperties; }
 simulationType laminar;
 DICT
+inlet_u=${NARIS_FOAM_INLET_U:-}
+[ -n "$inlet_u" ] ||
+  inlet_u="inlet { type surfaceNormalFixedValue; refValue uniform -$u_in; value uniform (0 0 0); }"
 cat > "$case/0/U" <<DICT
 FoamFile { version 2.0; format ascii; class volVectorField; object U; }
 dimensions [0 1 -1 0 0 0 0]; internalField uniform (0 0 0);
 boundaryField
 {
-  inlet { type surfaceNormalFixedValue; refValue uniform -$u_in; value uniform (0 0 0); }
+  $inlet_u
   outlet { type zeroGradient; }
   wall { type noSlip; }
 }
@@ -111,7 +117,9 @@ DICT
   timer=$!
   while kill -0 "$timer" 2>/dev/null; do
     sleep 5
-    if [ -n "$(settled_from "$settle_window")" ]; then pkill -TERM -P "$timer" -x simpleFoam || true; fi
+    if [ -z "${NARIS_FOAM_CONVERGE:-}" ] && [ -n "$(settled_from "$settle_window")" ]; then
+      pkill -TERM -P "$timer" -x simpleFoam || true
+    fi
   done
   wait "$timer" || true
 )
