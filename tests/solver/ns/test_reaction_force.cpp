@@ -13,6 +13,7 @@
 #include "solver/ns/reaction_force.h"
 #include "solver/ns/wall_stress.h"
 #include "solver/parallel/partition.h"
+#include "solver/parallel/petsc.h"
 #include "tests/solver/meshes.h"
 
 namespace naris::ns {
