@@ -14,9 +14,14 @@
 // whose cells OpenFOAM accepts, where the signed distance leaves slivers); --write-msh FILE
 // writes the (last) mesh in Gmsh 2.2; --field FILE traces through the velocities it lists
 // (one node per line, in units of Ū, in the mesh's node order) instead of solving.
+// --schiller-naumann drags the particles by Schiller–Naumann instead of Stokes, at the
+// experiment's scale: air at Re 1000 in the 1 mm tube (Ū ≈ 15 m/s), so that the particle
+// Reynolds numbers are those of Pui's laminar runs (0.6–3.9 at d/D = 0.002); Stk keeps its
+// Stokes τ.
 //
 //   bench_deposition [--uniform-inlet] [--inlet-tube L] [--diameter µm] [--binary]
-//                    [--write-msh FILE] [--field FILE] [particles = 10000] [cells across D ...]
+//                    [--schiller-naumann] [--write-msh FILE] [--field FILE]
+//                    [particles = 10000] [cells across D ...]
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -54,7 +59,7 @@ std::vector<Vec3> read_velocities(const std::string& path) {
 int main(int argc, char** argv) {
   petsc::Session session;
   set_verbosity(Verbosity::quiet);
-  bool uniform = false, binary = false;
+  bool uniform = false, binary = false, schiller_naumann = false;
   double diameter = 2e-6, inlet_tube = 0.0;
   std::string write_msh, field_file;
   std::vector<int> numbers;
@@ -62,6 +67,8 @@ int main(int argc, char** argv) {
     const std::string arg = argv[i];
     if (arg == "--uniform-inlet")
       uniform = true;
+    else if (arg == "--schiller-naumann")
+      schiller_naumann = true;
     else if (arg == "--binary")
       binary = true;
     else if (arg == "--diameter" && i + 1 < argc)
@@ -123,13 +130,19 @@ int main(int argc, char** argv) {
         }
       }
     }
-    const MeshFlow flow(m, field.velocity, {m.patch_id("inlet"), m.patch_id("outlet")});
-    const ReleaseSet seeds = flux_weighted_release(m, m.patch_id("inlet"), field.velocity, n, 1987);
     TraceOptions o;
-    o.drag = DragLaw::stokes;  // Stk defines the particle
+    o.drag = schiller_naumann ? DragLaw::schiller_naumann : DragLaw::stokes;
+    // The mean speed in m/s: 1 (only τŪ matters under Stokes drag), or Re ν / D.
+    const double mean_speed =
+        schiller_naumann ? re * o.air.viscosity / (o.air.density * 2.0 * a * 1e-3) : 1.0;
+    std::vector<Vec3> velocity = field.velocity;
+    for (Vec3& u : velocity) u *= mean_speed;
+    const MeshFlow flow(m, velocity, {m.patch_id("inlet"), m.patch_id("outlet")});
+    const ReleaseSet seeds = flux_weighted_release(m, m.patch_id("inlet"), velocity, n, 1987);
     for (double stk : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 1.0}) {
       const double d = diameter, cc = cunningham_factor(d, o.air.mean_free_path);
-      const ParticleKind kind{d, 18.0 * o.air.viscosity * (stk * a * 1e-3) / (d * d * cc)};
+      const double tau = stk * a * 1e-3 / mean_speed;
+      const ParticleKind kind{d, 18.0 * o.air.viscosity * tau / (d * d * cc)};
       Stopwatch clock;
       int counts[kFates] = {}, in_bend = 0;
       for (const Vec3& x : seeds.points) {
