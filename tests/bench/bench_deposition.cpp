@@ -14,13 +14,13 @@
 // whose cells OpenFOAM accepts, where the signed distance leaves slivers); --write-msh FILE
 // writes the (last) mesh in Gmsh 2.2; --field FILE traces through the velocities it lists
 // (one node per line, in units of Ū, in the mesh's node order) instead of solving.
-// --schiller-naumann drags the particles by Schiller–Naumann instead of Stokes, at the
+// --drag schiller-naumann drags the particles by Schiller–Naumann instead of Stokes, at the
 // experiment's scale: air at Re 1000 in the 1 mm tube (Ū ≈ 15 m/s), so that the particle
 // Reynolds numbers are those of Pui's laminar runs (0.6–3.9 at d/D = 0.002); Stk keeps its
 // Stokes τ.
 //
 //   bench_deposition [--uniform-inlet] [--inlet-tube L] [--diameter µm] [--binary]
-//                    [--schiller-naumann] [--write-msh FILE] [--field FILE]
+//                    [--drag LAW] [--write-msh FILE] [--field FILE]
 //                    [particles = 10000] [cells across D ...]
 #include <cmath>
 #include <cstdio>
@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "core/log.h"
 #include "mesh/io/write_gmsh.h"
 #include "solver/nonlinear/navier_stokes_solver.h"
@@ -59,7 +60,8 @@ std::vector<Vec3> read_velocities(const std::string& path) {
 int main(int argc, char** argv) {
   petsc::Session session;
   set_verbosity(Verbosity::quiet);
-  bool uniform = false, binary = false, schiller_naumann = false;
+  bool uniform = false, binary = false;
+  DragLaw drag = DragLaw::stokes;
   double diameter = 2e-6, inlet_tube = 0.0;
   std::string write_msh, field_file;
   std::vector<int> numbers;
@@ -67,9 +69,14 @@ int main(int argc, char** argv) {
     const std::string arg = argv[i];
     if (arg == "--uniform-inlet")
       uniform = true;
-    else if (arg == "--schiller-naumann")
-      schiller_naumann = true;
-    else if (arg == "--binary")
+    else if (arg == "--drag" && i + 1 < argc) {
+      try {
+        drag = parse_drag_law(argv[++i]);
+      } catch (const Error& e) {
+        std::fprintf(stderr, "%s\n", e.what());
+        return 1;
+      }
+    } else if (arg == "--binary")
       binary = true;
     else if (arg == "--diameter" && i + 1 < argc)
       diameter = std::atof(argv[++i]) * 1e-6;
@@ -91,6 +98,11 @@ int main(int argc, char** argv) {
   };
   // Lengths in units of D (read as millimetres), the velocity in units of Ū (read as m/s).
   const double a = 0.5, bend = 2.85, re = 1000.0;
+  TraceOptions o;
+  o.drag = drag;
+  // The mean speed in m/s: 1 under Stokes drag (only τŪ matters), else Re ν / D.
+  const double mean_speed =
+      drag == DragLaw::stokes ? 1.0 : re * o.air.viscosity / (o.air.density * 2.0 * a * 1e-3);
   std::printf(
       "| cells across D | cells | Stk = τŪ/(D/2) | deposited | Pui et al., this Stk | difference | "
       "Pui et al., Stk = τŪ/D | difference | particles | lost | trace (s) |\n");
@@ -130,15 +142,9 @@ int main(int argc, char** argv) {
         }
       }
     }
-    TraceOptions o;
-    o.drag = schiller_naumann ? DragLaw::schiller_naumann : DragLaw::stokes;
-    // The mean speed in m/s: 1 (only τŪ matters under Stokes drag), or Re ν / D.
-    const double mean_speed =
-        schiller_naumann ? re * o.air.viscosity / (o.air.density * 2.0 * a * 1e-3) : 1.0;
-    std::vector<Vec3> velocity = field.velocity;
-    for (Vec3& u : velocity) u *= mean_speed;
-    const MeshFlow flow(m, velocity, {m.patch_id("inlet"), m.patch_id("outlet")});
-    const ReleaseSet seeds = flux_weighted_release(m, m.patch_id("inlet"), velocity, n, 1987);
+    for (Vec3& u : field.velocity) u *= mean_speed;
+    const MeshFlow flow(m, field.velocity, {m.patch_id("inlet"), m.patch_id("outlet")});
+    const ReleaseSet seeds = flux_weighted_release(m, m.patch_id("inlet"), field.velocity, n, 1987);
     for (double stk : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 1.0}) {
       const double d = diameter, cc = cunningham_factor(d, o.air.mean_free_path);
       const double tau = stk * a * 1e-3 / mean_speed;
