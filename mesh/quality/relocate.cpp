@@ -169,6 +169,51 @@ std::vector<Plane> flat_patches(const HybridMesh& mesh) {
   return planes;
 }
 
+// The cells whose score a step may make the lowest: at most this many, within this band of it.
+constexpr std::size_t kMaxActive = 12;
+constexpr double kActiveBand = 0.2;
+
+// The point of the convex hull of g nearest the origin (zero when the origin is inside): the
+// steepest ascent of min_i g_i·d. In three dimensions it lies on a vertex, an edge or a triangle
+// of the hull, and it is the candidate p with p·g_i ≥ |p|² for every i.
+Vec shortest_in_hull(std::span<const Vec> g) {
+  const std::size_t k = g.size();
+  double scale = 0.0;
+  for (const Vec& v : g) scale = std::max(scale, v.squaredNorm());
+  if (!(scale > 0.0)) return Vec::Zero();
+  Vec best = Vec::Zero();
+  double best_norm = INFINITY;
+  auto consider = [&](const Vec& p) {
+    const double norm = p.squaredNorm();
+    if (norm >= best_norm) return;
+    for (const Vec& v : g)
+      if (p.dot(v) < norm - 1e-12 * scale) return;
+    best = p;
+    best_norm = norm;
+  };
+  for (std::size_t i = 0; i < k; ++i) {
+    consider(g[i]);
+    for (std::size_t j = i + 1; j < k; ++j) {
+      const Vec e = g[j] - g[i];
+      const double ee = e.squaredNorm();
+      if (ee > 0.0) {
+        const double t = -g[i].dot(e) / ee;
+        if (t > 0.0 && t < 1.0) consider(g[i] + t * e);
+      }
+      for (std::size_t l = j + 1; l < k; ++l) {
+        const Vec f = g[l] - g[i];
+        const double ef = e.dot(f), ff = f.squaredNorm();
+        const double det = ee * ff - ef * ef;
+        if (!(det > 1e-14 * ee * ff)) continue;
+        const double re = -g[i].dot(e), rf = -g[i].dot(f);
+        const double a = (re * ff - rf * ef) / det, b = (rf * ee - re * ef) / det;
+        if (a > 0.0 && b > 0.0 && a + b < 1.0) consider(g[i] + a * e + b * f);
+      }
+    }
+  }
+  return best;
+}
+
 class Relocator {
  public:
   Relocator(HybridMesh& mesh, const LevelSet* wall, const std::vector<bool>& on_surface,
@@ -361,23 +406,21 @@ class Relocator {
       std::array<Vec, 7> directions;
       int count = 0;
       std::int32_t worst_cell = around[0];
-      // The worst cell's score gradient, by forward differences.
+      // The ascent direction of the lowest score: the shortest vector in the convex hull of the
+      // (tangential) score gradients of the cells that a step of h could make the worst (the
+      // max-min smoothing of Freitag & Ollivier-Gooch); where one cell alone is that low, its
+      // gradient. Zero where no direction raises them all: then only the pattern's axes remain.
       {
-        double worst = INFINITY;
         auto at = [&](NodeId m) -> const Vec& { return m == n ? x : mesh_.nodes[m]; };
+        double worst = INFINITY;
+        scores_.clear();
         for (auto c : around) {
           const double s = score_(cells_[static_cast<std::size_t>(c)], at);
+          scores_.push_back(s);
           if (s < worst) worst = s, worst_cell = c;
         }
-        const double delta = 1e-5 * length;
-        Vec gradient;
-        for (int d = 0; d < 3; ++d) {
-          Vec y = x;
-          y[d] += delta;
-          auto moved_at = [&](NodeId m) -> const Vec& { return m == n ? y : mesh_.nodes[m]; };
-          gradient[d] =
-              (score_(cells_[static_cast<std::size_t>(worst_cell)], moved_at) - worst) / delta;
-        }
+        // The moves n may make: a projection onto its plane, its line, or none.
+        Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity();
         if (freedom == Freedom::surface || freedom == Freedom::plane) {
           Vec normal;
           if (plane) {
@@ -387,9 +430,9 @@ class Relocator {
             if (!wall_->evaluate(x, value, normal) || !(normal.squaredNorm() > 0.0)) return moved;
             normal.normalize();
           }
-          gradient -= gradient.dot(normal) * normal;
+          tangent -= normal * normal.transpose();
           const Vec t1 = normal.unitOrthogonal(), t2 = normal.cross(t1);
-          directions = {gradient, t1, -t1, t2, -t2, Vec::Zero(), Vec::Zero()};
+          directions = {Vec::Zero(), t1, -t1, t2, -t2, Vec::Zero(), Vec::Zero()};
           count = 5;
         } else if (freedom == Freedom::rim) {
           // Along the line where the wall meets the plane.
@@ -399,14 +442,34 @@ class Relocator {
           Vec t = plane->normal.cross(wall_normal);
           if (!(t.squaredNorm() > 0.0)) return moved;
           t.normalize();
-          directions = {gradient.dot(t) * t, t,           -t,         Vec::Zero(),
-                        Vec::Zero(),         Vec::Zero(), Vec::Zero()};
+          tangent = t * t.transpose();
+          directions = {Vec::Zero(), t, -t, Vec::Zero(), Vec::Zero(), Vec::Zero(), Vec::Zero()};
           count = 3;
         } else {
-          directions = {gradient,      Vec::UnitX(), -Vec::UnitX(), Vec::UnitY(),
+          directions = {Vec::Zero(),   Vec::UnitX(), -Vec::UnitX(), Vec::UnitY(),
                         -Vec::UnitY(), Vec::UnitZ(), -Vec::UnitZ()};
           count = 7;
         }
+        const double delta = 1e-5 * length;
+        gradients_.clear();
+        for (std::size_t i = 0; i < around.size(); ++i) {
+          const double s = scores_[i];
+          if (s > worst + kActiveBand ||
+              (gradients_.size() >= kMaxActive && around[i] != worst_cell))
+            continue;
+          const std::size_t c = static_cast<std::size_t>(around[i]);
+          Vec gradient;
+          for (int d = 0; d < 3; ++d) {
+            Vec y = x;
+            y[d] += delta;
+            auto moved_at = [&](NodeId m) -> const Vec& { return m == n ? y : mesh_.nodes[m]; };
+            gradient[d] = (score_(cells_[c], moved_at) - s) / delta;
+          }
+          gradient = tangent * gradient;
+          if (around[i] == worst_cell || s - worst <= h * gradient.norm())
+            gradients_.push_back(gradient);
+        }
+        directions[0] = shortest_in_hull(gradients_);
         if (directions[0].squaredNorm() > 0.0)
           directions[0].normalize();
         else
@@ -448,6 +511,8 @@ class Relocator {
   std::vector<Plane> planes_;        // of each patch
   NodeIncidence node_cells_, node_faces_;
   std::vector<float> score_of_;  // of every cell, as the nodes stand
+  std::vector<double> scores_;   // of the cells around the node being moved
+  std::vector<Vec> gradients_;   // of those that may become its worst
 };
 
 // Tetrahedra below target with two or three faces on one surface patch are removed: all their
