@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "mesh/mve/mve.h"
+#include "mesh/patches/patches.h"
 #include "mesh/pipeline/mesh_job.h"
 #include "mesh/quality/check.h"
 #include "mesh/quality/improve.h"
@@ -164,6 +165,66 @@ TEST(Relocate, CutPlaneNodesMoveInTheirPlaneAndTheRimOnBoth) {
   }
   std::printf("[ info ] %zu of %zu rim nodes moved\n", rim_moved, rim_after.size());
   EXPECT_GT(rim_moved, 0u);
+}
+
+// An oblique inlet through a labelmap's tube, as a CT case's `--inlet p=…;n=…`: the collapses
+// of 3.3 merge some of its isopoints into hexahedron nodes off the plane. The nodes on the plane
+// still move in it (the plane is fitted to them); those off it stay where they are.
+TEST(Relocate, AnObliqueInletsNodesMoveInItsPlaneThoughCollapsesLeftSomeOffIt) {
+  const int n = 28;
+  const Eigen::Vector2d axis(13.37, 13.71);
+  const auto volume = testing::sampled_volume<float>(n, n, n, [&](int i, int j, int k) {
+    return (Eigen::Vector2d(i, j) - axis).norm() < 9.3 + 0.8 * std::sin(0.5 * k) ? 1.0 : 0.0;
+  });
+  const mve::VolumeField field(volume, InsideRule::label, 1.0);
+  mve::MveOptions options = testing::quiet_options();
+  const std::vector<Cut> cuts = {{"inlet", parse_cut_plane("p=13.4,13.7,6.3;n=0.31,0.23,0.92")}};
+  const PreparedCuts prepared = prepare_cuts(field, cuts, options);
+  HybridMesh mesh = mve::march_volume_elements(field, options);
+  finish_patches(mesh, field, cuts, prepared, {}, options.wall_patch);
+  improve_mesh(mesh, 1.0, ImproveOptions{});
+  const int inlet = mesh.patch_id("inlet");
+  ASSERT_GE(inlet, 0);
+  const CutPlane& plane = cuts[0].plane;
+  // The inlet's nodes that are on no other patch: on the plane, and off it.
+  auto inlet_nodes = [&](const HybridMesh& m, std::set<std::array<double, 3>>& on,
+                         std::size_t& off) {
+    std::vector<int> patches(m.nodes.size(), 0);
+    for_each_boundary_face(m, [&](std::span<const NodeId> f, std::int32_t p) {
+      for (NodeId v : f) patches[v] |= p == inlet ? 1 : 2;
+    });
+    on.clear();
+    off = 0;
+    for (std::size_t v = 0; v < m.nodes.size(); ++v) {
+      if (patches[v] != 1) continue;
+      const Eigen::Vector3d& x = m.nodes[v];
+      if (std::abs(plane.normal.dot(x - plane.point)) < 1e-9)
+        on.insert({x.x(), x.y(), x.z()});
+      else
+        ++off;
+    }
+  };
+  std::set<std::array<double, 3>> on_before, on_after;
+  std::size_t off_before = 0, off_after = 0;
+  inlet_nodes(mesh, on_before, off_before);
+
+  std::vector<bool> on_surface(mesh.patch_names.size(), false);
+  on_surface[static_cast<std::size_t>(mesh.patch_id("wall"))] = true;
+  const RelocateStats s = relocate_nodes(mesh, &field, on_surface, RelocateOptions{});
+  inlet_nodes(mesh, on_after, off_after);
+  std::size_t moved = 0;
+  for (const auto& x : on_after) moved += on_before.count(x) == 0;
+  std::printf(
+      "[ info ] inlet nodes on its plane %zu, off it %zu (merged into hexahedron nodes); %zu "
+      "moved in the plane; worst score %.4f → %.4f\n",
+      on_before.size(), off_before, moved, s.worst_before, s.worst_after);
+  const MeshCheck check = check_mesh(mesh);
+  ASSERT_TRUE(check.valid()) << check.describe();
+  EXPECT_GT(off_before, 0u);  // the case this test is about
+  EXPECT_EQ(off_after, off_before);
+  EXPECT_EQ(on_after.size(), on_before.size());
+  EXPECT_GT(moved, 0u);
+  EXPECT_GT(s.worst_after, s.worst_before);
 }
 
 // Issue 30's targets on a real airway: after relocation every tetrahedron of neonate-a has its
