@@ -188,9 +188,11 @@ std::vector<Plane> flat_patches(const HybridMesh& mesh) {
     }
     if (10 * most < 9 * on.size()) continue;
     Vec centre = Vec::Zero();
+    std::size_t count = 0;
     for (NodeId n : on)
-      if (std::abs(normal.dot(mesh.nodes[n]) - offset) <= tolerance) centre += mesh.nodes[n];
-    centre /= static_cast<double>(most);
+      if (std::abs(normal.dot(mesh.nodes[n]) - offset) <= tolerance)
+        centre += mesh.nodes[n], ++count;
+    centre /= static_cast<double>(count);
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
     for (NodeId n : on)
       if (std::abs(normal.dot(mesh.nodes[n]) - offset) <= tolerance) {
@@ -214,7 +216,8 @@ std::vector<Plane> flat_patches(const HybridMesh& mesh) {
   return planes;
 }
 
-// The cells whose score a step may make the lowest: at most this many, within this band of it.
+// The cells whose score a step may make the lowest: within this band of it, the worst cell and at
+// most this many others (in the node's cell order).
 constexpr std::size_t kMaxActive = 12;
 constexpr double kActiveBand = 0.2;
 
@@ -231,8 +234,9 @@ Vec shortest_in_hull(std::span<const Vec> g) {
   auto consider = [&](const Vec& p) {
     const double norm = p.squaredNorm();
     if (norm >= best_norm) return;
+    const double slack = 1e-9 * std::sqrt(norm * scale);  // rounding of p·v, relative
     for (const Vec& v : g)
-      if (p.dot(v) < norm - 1e-12 * scale) return;
+      if (p.dot(v) < norm - slack) return;
     best = p;
     best_norm = norm;
   };
@@ -256,7 +260,8 @@ Vec shortest_in_hull(std::span<const Vec> g) {
       }
     }
   }
-  return best;
+  // A candidate of rounding size is the origin: no direction raises every score.
+  return best_norm <= 1e-18 * scale ? Vec::Zero() : best;
 }
 
 class Relocator {
@@ -425,7 +430,7 @@ class Relocator {
   }
 
   // Pattern search for the position of n that maximizes the lowest score of its cells: the
-  // gradient of the worst cell's score first, then the axes (or, on the wall, two tangents),
+  // steepest ascent of the lowest score first, then the axes (or, on the wall, two tangents),
   // halving the step when nothing improves. Returns whether n moved.
   bool improve(NodeId n) {
     const auto around = node_cells_.of(n);
@@ -506,12 +511,16 @@ class Relocator {
             continue;
           const std::size_t c = static_cast<std::size_t>(around[i]);
           Vec gradient;
+          bool inverted = false;  // by the difference step: no gradient
           for (int d = 0; d < 3; ++d) {
             Vec y = x;
             y[d] += delta;
             auto moved_at = [&](NodeId m) -> const Vec& { return m == n ? y : mesh_.nodes[m]; };
-            gradient[d] = (score_(cells_[c], moved_at) - s) / delta;
+            const double stepped = score_(cells_[c], moved_at);
+            inverted = inverted || (stepped < 0.0 && s >= 0.0);
+            gradient[d] = (stepped - s) / delta;
           }
+          if (inverted) continue;
           gradient = tangent * gradient;
           if (around[i] == worst_cell || s - worst <= h * gradient.norm())
             gradients_.push_back(gradient);
