@@ -365,6 +365,12 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
       const double now = cell_shape(after, x);
       if (!(now > 0.0)) return false;
       if (now >= options.min_scaled_jacobian) return true;
+      // A cell left with another short edge at the merged node is the next collapse's: a cluster
+      // of isopoints near one lattice vertex (a cut plane passing it) goes edge by edge.
+      for (const auto& e : cell_edges(after.size)) {
+        const NodeId p = after.v[e[0]], q = after.v[e[1]];
+        if ((p == a || q == a) && (x[p] - x[q]).norm() < min_edge) return true;
+      }
       x[a] = xa;
       x[b] = xb;
       const double old = cell_shape(before, x);

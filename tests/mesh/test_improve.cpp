@@ -53,6 +53,38 @@ TEST(Improve, SphereKeepsInvariantsAndVolume) {
     EXPECT_NEAR(q[i].scaled_jacobian, 1.0, 1e-9);
 }
 
+// A cut plane passing a lattice vertex closer than the isopoint margin leaves a cluster of
+// isopoints a thousandth of a voxel apart around it. Collapsing it edge by edge makes cells flat
+// on the way; they are the next collapse's, so the cluster goes.
+TEST(Improve, AClusterWhereACutPlanePassesALatticeVertexCollapses) {
+  const int n = 24;
+  const Eigen::Vector2d axis(11.37, 11.71);
+  Volume<float> volume;
+  volume.frame.dims = {n, n, n};
+  volume.values.resize(volume.frame.voxel_count());
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        volume.at(i, j, k) = (Eigen::Vector2d(i, j) - axis).norm() < 8.3 ? 1.0f : 0.0f;
+  const mve::VolumeField field(volume, InsideRule::label, 1.0);
+  mve::MveOptions options = testing::quiet_options();
+  mve::ClipPlane plane;
+  plane.normal = Eigen::Vector3d(0.31, 0.23, 0.92).normalized();
+  const Eigen::Vector3d vertex(12, 11, 9);
+  plane.offset = -plane.normal.dot(vertex) - 4e-4;  // the vertex cut off by 0.0004 voxel
+  options.clip_planes.push_back(plane);
+  HybridMesh m = mve::march_volume_elements(field, options);
+  const std::size_t tiny_before = short_edges(m, 0.01);
+  const ImproveStats s = improve_mesh(m, 1.0, ImproveOptions{});
+  const MeshCheck check = check_mesh(m);
+  ASSERT_TRUE(check.valid()) << check.describe();
+  std::printf("[ info ] tet edges under 0.01 voxel %zu → %zu; collapsed %zu, refused %zu + %zu\n",
+              tiny_before, short_edges(m, 0.01), s.collapsed, s.refused_topology,
+              s.refused_geometry);
+  EXPECT_GT(tiny_before, 0u);  // the cluster exists
+  EXPECT_EQ(short_edges(m, 0.01), 0u);
+}
+
 TEST(Improve, RandomFieldsStayConformingWatertightAndPositive) {
   for (std::uint32_t seed = 1; seed <= 60; ++seed) {
     std::mt19937 rng(seed);
