@@ -146,11 +146,17 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     const auto& q = mesh.boundary_quads[f];
     faces.push_back({4, {q[0], q[1], q[2], q[3]}, mesh.boundary_quad_patch[f]});
   }
-  // A node's patch: -1 interior, ≥ 0 one patch, -2 on a line between patches (never moves).
+  // A node's patch: -1 interior, ≥ 0 one patch, -2 on a line between patches. A line node's two
+  // patches (both -2 where three or more meet).
   std::vector<std::int32_t> patch(n_nodes, -1);
+  std::vector<std::array<std::int32_t, 2>> line(n_nodes, {-1, -1});
   for (const auto& f : faces)
     for (int k = 0; k < f.size; ++k) {
-      auto& p = patch[f.v[k]];
+      const NodeId n = f.v[k];
+      auto& p = patch[n];
+      if (p != -1 && p != f.patch && p != -2)
+        line[n] = {std::min(p, f.patch), std::max(p, f.patch)};
+      if (p == -2 && f.patch != line[n][0] && f.patch != line[n][1]) line[n] = {-2, -2};
       p = p == -1 || p == f.patch ? f.patch : -2;
     }
 
@@ -216,13 +222,32 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     // movable nodes meet at their midpoint. A wall node may merge into a fixed interior node,
     // which then joins the wall (the wall moves by less than the edge, < min_edge).
     auto movable = [&](NodeId n) { return !locked[n] && patch[n] != -2; };
-    if (!movable(a) && !movable(b)) {
+    // Two nodes of one line between the same two patches, joined by an edge of that line, merge
+    // along it at one of them (not a hexahedron's): a cut plane's rim keeps its shape.
+    bool along_line = false;
+    if (patch[a] == -2 && patch[b] == -2 && line[a] == line[b] && line[a][0] >= 0 &&
+        !(locked[a] && locked[b])) {
+      std::array<std::int32_t, 2> sides{-1, -1};
+      int count = 0;
+      node_faces.for_each(a, [&](std::int32_t f) {
+        const Face& face = faces[f];
+        if (!face.size || !has(face, a) || !has(face, b)) return;
+        for (int k = 0; k < face.size; ++k) {
+          const NodeId p = face.v[k], q = face.v[(k + 1) % face.size];
+          if (((p == a && q == b) || (p == b && q == a)) && count < 2) sides[count++] = face.patch;
+        }
+      });
+      along_line =
+          count == 2 && std::minmax(sides[0], sides[1]) == std::minmax(line[a][0], line[a][1]);
+      if (along_line && locked[b]) std::swap(a, b);
+    }
+    if (!along_line && !movable(a) && !movable(b)) {
       ++stats.refused_topology;
       continue;
     }
-    if (movable(a) && !movable(b))
+    if (!along_line && movable(a) && !movable(b))
       std::swap(a, b);
-    else if (movable(a) && movable(b) && patch[a] == -1 && patch[b] >= 0)
+    else if (!along_line && movable(a) && movable(b) && patch[a] == -1 && patch[b] >= 0)
       std::swap(a, b);
     // Now b moves; a stays unless both are movable with the same patch.
     if (patch[a] >= 0 && patch[b] >= 0 && patch[a] != patch[b]) {

@@ -2,8 +2,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <random>
+#include <set>
+#include <span>
 
+#include "mesh/image/nasal_airway.h"
+#include "mesh/image/read_volume.h"
+#include "mesh/image/write_volume.h"
+#include "mesh/pipeline/mesh_job.h"
 #include "mesh/quality/check.h"
 #include "mesh/quality/improve.h"
 #include "mesh/quality/quality.h"
@@ -83,6 +90,51 @@ TEST(Improve, AClusterWhereACutPlanePassesALatticeVertexCollapses) {
               s.refused_geometry);
   EXPECT_GT(tiny_before, 0u);  // the cluster exists
   EXPECT_EQ(short_edges(m, 0.01), 0u);
+}
+
+// An adult CT's right cavity (NasalSeg P055; Zhang et al. 2024, CC BY 4.0) cut at its naris by
+// the oblique plane the segmentation finds. Where the plane passes a lattice vertex on the wall,
+// its rim (where the inlet meets the wall) gets nodes hundredths of a millimetre apart. Rim nodes
+// joined by a rim edge merge along it; only pyramids' lateral edges, which 3.3 never collapses,
+// may stay that short.
+TEST(Improve, AnAdultNarisRimKeepsNoShortEdge) {
+  const std::filesystem::path ct_file =
+      std::filesystem::path(NARIS_SHARED_DATA) / "nasalseg" / "P055_img.nrrd";
+  if (!std::filesystem::exists(ct_file)) GTEST_SKIP() << "shared data absent: " << ct_file;
+  const NasalAirway airway = segment_nasal_airway(read_volume(ct_file), NasalAirwayOptions{});
+  const auto dir = std::filesystem::temp_directory_path() / "naris-improve-rim";
+  std::filesystem::create_directories(dir);
+  write_labelmap_nrrd(airway.mask, dir / "airway.nrrd");
+  MeshJob job;
+  job.input = dir / "airway.nrrd";
+  job.inlet = airway.inlet;
+  job.outlet = airway.outlet;
+  const MeshJobResult r = run_mesh_job(job);
+  ASSERT_TRUE(r.check.has_value());
+  ASSERT_TRUE(r.check->valid()) << r.check->describe();
+  const HybridMesh& m = r.mesh;
+  const int wall = m.patch_id("wall"), inlet = m.patch_id("inlet");
+  ASSERT_GE(inlet, 0);
+  std::vector<int> side(m.nodes.size(), 0);
+  for_each_boundary_face(m, [&](std::span<const NodeId> f, std::int32_t p) {
+    for (NodeId v : f) side[v] |= p == wall ? 1 : p == inlet ? 2 : 4;
+  });
+  std::set<std::pair<NodeId, NodeId>> lateral, short_rim;
+  for (const auto& p : m.pyramids)
+    for (int k = 0; k < 4; ++k) lateral.insert(std::minmax(p[k], p[4]));
+  const double limit = 0.05 * airway.mask.frame.spacing.minCoeff();
+  for_each_boundary_face(m, [&](std::span<const NodeId> f, std::int32_t) {
+    for (std::size_t k = 0; k < f.size(); ++k) {
+      const auto e = std::minmax(f[k], f[(k + 1) % f.size()]);
+      if (side[e.first] == 3 && side[e.second] == 3 &&
+          (m.nodes[e.first] - m.nodes[e.second]).norm() < limit && !lateral.count(e))
+        short_rim.insert(e);
+    }
+  });
+  std::printf("[ info ] rim edges under %.3f mm: %zu; collapsed %zu, refused %zu + %zu\n", limit,
+              short_rim.size(), r.improvement.collapsed, r.improvement.refused_topology,
+              r.improvement.refused_geometry);
+  EXPECT_EQ(short_rim.size(), 0u);
 }
 
 TEST(Improve, RandomFieldsStayConformingWatertightAndPositive) {
