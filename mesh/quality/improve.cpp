@@ -217,28 +217,36 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
   for (const auto& [len0, a0, b0] : edges) {
     NodeId a = find(a0), b = find(b0);
     if (a == b || (x[a] - x[b]).norm() >= min_edge) continue;
-    // Which node survives (a), and where. Hexahedron nodes and nodes on a line between
-    // patches never move. A movable node merges into a fixed one at the fixed position; two
-    // movable nodes meet at their midpoint. A wall node may merge into a fixed interior node,
-    // which then joins the wall (the wall moves by less than the edge, < min_edge).
+    // Which node survives (a), and where. Hexahedron nodes never move; nodes on a line between
+    // patches only along it (below). A movable node merges into a fixed one at the fixed
+    // position; two movable nodes meet at their midpoint. A wall node may merge into a fixed
+    // interior node, which then joins the wall (the wall moves by less than the edge).
     auto movable = [&](NodeId n) { return !locked[n] && patch[n] != -2; };
     // Two nodes of one line between the same two patches, joined by an edge of that line, merge
     // along it at one of them (not a hexahedron's): a cut plane's rim keeps its shape.
     bool along_line = false;
     if (patch[a] == -2 && patch[b] == -2 && line[a] == line[b] && line[a][0] >= 0 &&
         !(locked[a] && locked[b])) {
-      std::array<std::int32_t, 2> sides{-1, -1};
+      // The distinct boundary faces on edge ab (a's list may hold a merged face twice).
+      std::array<std::int32_t, 3> on_edge{-1, -1, -1};
       int count = 0;
       node_faces.for_each(a, [&](std::int32_t f) {
         const Face& face = faces[f];
         if (!face.size || !has(face, a) || !has(face, b)) return;
+        if (std::find(on_edge.begin(), on_edge.begin() + std::min(count, 3), f) !=
+            on_edge.begin() + std::min(count, 3))
+          return;
         for (int k = 0; k < face.size; ++k) {
           const NodeId p = face.v[k], q = face.v[(k + 1) % face.size];
-          if (((p == a && q == b) || (p == b && q == a)) && count < 2) sides[count++] = face.patch;
+          if ((p == a && q == b) || (p == b && q == a)) {
+            if (count < 3) on_edge[static_cast<std::size_t>(count)] = f;
+            ++count;
+            break;
+          }
         }
       });
-      along_line =
-          count == 2 && std::minmax(sides[0], sides[1]) == std::minmax(line[a][0], line[a][1]);
+      along_line = count == 2 && std::minmax(faces[on_edge[0]].patch, faces[on_edge[1]].patch) ==
+                                     std::minmax(line[a][0], line[a][1]);
       if (along_line && locked[b]) std::swap(a, b);
     }
     if (!along_line && !movable(a) && !movable(b)) {
@@ -385,16 +393,23 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     x[a] = target;
     x[b] = target;
     // A changed cell must stay valid, and may fall below the quality floor only if it was
-    // already worse before the collapse.
+    // already worse before the collapse, or if it is the next collapse's (below).
     auto acceptable = [&](const Cell& before, const Cell& after) {
       const double now = cell_shape(after, x);
       if (!(now > 0.0)) return false;
       if (now >= options.min_scaled_jacobian) return true;
-      // A cell left with another short edge at the merged node is the next collapse's: a cluster
-      // of isopoints near one lattice vertex (a cut plane passing it) goes edge by edge.
-      for (const auto& e : cell_edges(after.size)) {
-        const NodeId p = after.v[e[0]], q = after.v[e[1]];
-        if ((p == a || q == a) && (x[p] - x[q]).norm() < min_edge) return true;
+      // A cell left with another short edge at the merged node that a collapse may take (not a
+      // pyramid's lateral edge, the other end movable or on a's line) is the next collapse's: a
+      // cluster of isopoints near one lattice vertex (a cut plane passing it) goes edge by edge.
+      const auto& edges_of = cell_edges(after.size);
+      for (std::size_t k = 0; k < edges_of.size(); ++k) {
+        const NodeId p = after.v[edges_of[k][0]], q = after.v[edges_of[k][1]];
+        if (p != a && q != a) continue;
+        const NodeId other = p == a ? q : p;
+        const bool lateral = after.size == 5 && (edges_of[k][0] == 4 || edges_of[k][1] == 4);
+        const bool collapsible =
+            movable(other) || (patch[other] == -2 && line[other] == line[a] && line[a][0] >= 0);
+        if (!lateral && collapsible && (x[p] - x[q]).norm() < min_edge) return true;
       }
       x[a] = xa;
       x[b] = xb;
