@@ -57,6 +57,14 @@ bool has(const Cell& c, NodeId n) {
 bool has(const Face& f, NodeId n) {
   return std::find(f.v.begin(), f.v.begin() + f.size, n) != f.v.begin() + f.size;
 }
+// a–b is one of the face's edges (not a quadrilateral's diagonal).
+bool has_edge(const Face& f, NodeId a, NodeId b) {
+  for (int k = 0; k < f.size; ++k) {
+    const NodeId p = f.v[k], q = f.v[(k + 1) % f.size];
+    if ((p == a && q == b) || (p == b && q == a)) return true;
+  }
+  return false;
+}
 
 double tet6(const Vec& a, const Vec& b, const Vec& c, const Vec& d) {
   return (b - a).cross(c - a).dot(d - a);
@@ -222,28 +230,21 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     // position; two movable nodes meet at their midpoint. A wall node may merge into a fixed
     // interior node, which then joins the wall (the wall moves by less than the edge).
     auto movable = [&](NodeId n) { return !locked[n] && patch[n] != -2; };
-    // Two nodes of one line between the same two patches, joined by an edge of that line, merge
-    // along it at one of them (not a hexahedron's): a cut plane's rim keeps its shape.
+    // p and q on the line between the same two patches.
+    auto one_line = [&](NodeId p, NodeId q) { return line[p][0] >= 0 && line[p] == line[q]; };
+    // Two nodes of one line, joined by an edge of that line, merge along it at one of them (not
+    // a hexahedron's): a cut plane's rim keeps its shape.
     bool along_line = false;
-    if (patch[a] == -2 && patch[b] == -2 && line[a] == line[b] && line[a][0] >= 0 &&
-        !(locked[a] && locked[b])) {
-      // The distinct boundary faces on edge ab (a's list may hold a merged face twice).
-      std::array<std::int32_t, 3> on_edge{-1, -1, -1};
+    if (one_line(a, b) && !(locked[a] && locked[b])) {
+      // The distinct boundary faces on edge ab (a's list may hold a merged face twice); a third
+      // one already rules the edge out.
+      std::array<std::int32_t, 3> on_edge{};
       int count = 0;
       node_faces.for_each(a, [&](std::int32_t f) {
-        const Face& face = faces[f];
-        if (!face.size || !has(face, a) || !has(face, b)) return;
-        if (std::find(on_edge.begin(), on_edge.begin() + std::min(count, 3), f) !=
-            on_edge.begin() + std::min(count, 3))
+        if (count == 3 || !faces[f].size || !has_edge(faces[f], a, b) ||
+            std::find(on_edge.begin(), on_edge.begin() + count, f) != on_edge.begin() + count)
           return;
-        for (int k = 0; k < face.size; ++k) {
-          const NodeId p = face.v[k], q = face.v[(k + 1) % face.size];
-          if ((p == a && q == b) || (p == b && q == a)) {
-            if (count < 3) on_edge[static_cast<std::size_t>(count)] = f;
-            ++count;
-            break;
-          }
-        }
+        on_edge[static_cast<std::size_t>(count++)] = f;
       });
       along_line = count == 2 && std::minmax(faces[on_edge[0]].patch, faces[on_edge[1]].patch) ==
                                      std::minmax(line[a][0], line[a][1]);
@@ -407,8 +408,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
         if (p != a && q != a) continue;
         const NodeId other = p == a ? q : p;
         const bool lateral = after.size == 5 && (edges_of[k][0] == 4 || edges_of[k][1] == 4);
-        const bool collapsible =
-            movable(other) || (patch[other] == -2 && line[other] == line[a] && line[a][0] >= 0);
+        const bool collapsible = movable(other) || one_line(a, other);
         if (!lateral && collapsible && (x[p] - x[q]).norm() < min_edge) return true;
       }
       x[a] = xa;

@@ -170,48 +170,40 @@ std::vector<Plane> flat_patches(const HybridMesh& mesh) {
     const double size = extent.diagonal().norm();
     std::mt19937 random(20261207);
     std::uniform_int_distribution<std::size_t> pick(0, on.size() - 1);
-    auto count_on = [&](const Vec& normal, double offset) {
+    auto count_on = [&](const Plane& plane) {
       std::size_t count = 0;
-      for (NodeId n : on) count += std::abs(normal.dot(mesh.nodes[n]) - offset) <= tolerance;
+      for (NodeId n : on) count += plane.holds(mesh.nodes[n]);
       return count;
     };
-    Vec normal = Vec::Zero();
-    double offset = 0.0;
+    Plane best;
     std::size_t most = 0;
     for (int trial = 0; trial < 32; ++trial) {
       const Vec& a = mesh.nodes[on[pick(random)]];
       const Vec cross = (mesh.nodes[on[pick(random)]] - a).cross(mesh.nodes[on[pick(random)]] - a);
       if (!(cross.norm() > 1e-3 * size * size)) continue;  // too close to a line
-      const Vec trial_normal = cross.normalized();
-      const std::size_t count = count_on(trial_normal, trial_normal.dot(a));
-      if (count > most) most = count, normal = trial_normal, offset = normal.dot(a);
+      const Plane candidate{cross.normalized(), cross.normalized().dot(a), tolerance};
+      const std::size_t count = count_on(candidate);
+      if (count > most) most = count, best = candidate;
     }
     if (10 * most < 9 * on.size()) continue;
     Vec centre = Vec::Zero();
-    std::size_t count = 0;
+    std::size_t inliers = 0;
     for (NodeId n : on)
-      if (std::abs(normal.dot(mesh.nodes[n]) - offset) <= tolerance)
-        centre += mesh.nodes[n], ++count;
-    centre /= static_cast<double>(count);
+      if (best.holds(mesh.nodes[n])) centre += mesh.nodes[n], ++inliers;
+    centre /= static_cast<double>(inliers);
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
     for (NodeId n : on)
-      if (std::abs(normal.dot(mesh.nodes[n]) - offset) <= tolerance) {
+      if (best.holds(mesh.nodes[n])) {
         const Vec d = mesh.nodes[n] - centre;
         scatter += d * d.transpose();
       }
-    Vec fitted = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
-    if (fitted.dot(area[p]) < 0.0) fitted = -fitted;
+    Vec normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+    if (normal.dot(area[p]) < 0.0) normal = -normal;
     // A plane along an image axis keeps its nodes' coordinate exactly.
     for (int k = 0; k < 3; ++k)
-      if (std::abs(fitted[k]) > 1.0 - 1e-12) fitted = Vec::Unit(k) * (fitted[k] > 0 ? 1.0 : -1.0);
-    normal = fitted;
-    offset = normal.dot(centre);
-    std::size_t on_plane = 0;
-    for (NodeId n : on) on_plane += std::abs(normal.dot(mesh.nodes[n]) - offset) <= tolerance;
-    if (10 * on_plane < 9 * on.size()) continue;
-    planes[p].normal = normal;
-    planes[p].offset = offset;
-    planes[p].tolerance = tolerance;
+      if (std::abs(normal[k]) > 1.0 - 1e-12) normal = Vec::Unit(k) * (normal[k] > 0 ? 1.0 : -1.0);
+    const Plane fitted{normal, normal.dot(centre), tolerance};
+    if (10 * count_on(fitted) >= 9 * on.size()) planes[p] = fitted;
   }
   return planes;
 }

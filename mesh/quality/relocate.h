@@ -40,9 +40,8 @@ struct RelocateStats {
 // on_surface[p]: the faces of patch p lie on `wall` (the wall and the regions cut from it); their
 // nodes slide on it. Nodes of another patch that is flat (a cut plane, a box side: nine tenths of
 // its nodes on one plane) move within its plane, and those on its line with the wall along that
-// line; its nodes off the plane stay. Without `wall` the wall's
-// nodes stay. unchanged_from (as improve_mesh gives it, one entry per cell in the mesh's order)
-// gets −1 for every cell that moved.
+// line; its nodes off the plane stay. Without `wall` the wall's nodes stay. unchanged_from (as
+// improve_mesh gives it, one entry per cell in the mesh's order) gets −1 for every cell that moved.
 RelocateStats relocate_nodes(HybridMesh& mesh, const LevelSet* wall,
                              const std::vector<bool>& on_surface, const RelocateOptions& options,
                              std::vector<std::int64_t>* unchanged_from = nullptr);

@@ -66,13 +66,9 @@ TEST(Improve, SphereKeepsInvariantsAndVolume) {
 TEST(Improve, AClusterWhereACutPlanePassesALatticeVertexCollapses) {
   const int n = 24;
   const Eigen::Vector2d axis(11.37, 11.71);
-  Volume<float> volume;
-  volume.frame.dims = {n, n, n};
-  volume.values.resize(volume.frame.voxel_count());
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        volume.at(i, j, k) = (Eigen::Vector2d(i, j) - axis).norm() < 8.3 ? 1.0f : 0.0f;
+  const auto volume = testing::sampled_volume<float>(n, n, n, [&](int i, int j, int) {
+    return (Eigen::Vector2d(i, j) - axis).norm() < 8.3 ? 1.0 : 0.0;
+  });
   const mve::VolumeField field(volume, InsideRule::label, 1.0);
   mve::MveOptions options = testing::quiet_options();
   mve::ClipPlane plane;
