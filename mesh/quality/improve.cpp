@@ -250,7 +250,18 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
                                      std::minmax(line[a][0], line[a][1]);
       if (along_line && locked[b]) std::swap(a, b);
     }
-    if (!along_line && !movable(a) && !movable(b)) {
+    // A node of a line between patches merges into a hexahedron node on one of those patches
+    // (a collapse made the lattice vertex a node of a cut plane): the line then passes the vertex.
+    auto into_vertex_of = [&](NodeId p, NodeId q) {
+      return locked[p] && !locked[q] && patch[q] == -2 && line[q][0] >= 0 && patch[p] >= 0 &&
+             (patch[p] == line[q][0] || patch[p] == line[q][1]);
+    };
+    bool into_vertex = false;
+    if (!along_line) {
+      if (into_vertex_of(b, a)) std::swap(a, b);
+      into_vertex = into_vertex_of(a, b);
+    }
+    if (!along_line && !into_vertex && !movable(a) && !movable(b)) {
       ++stats.refused_topology;
       continue;
     }
@@ -476,7 +487,8 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     node_cells.merge(b, a);
     node_faces.merge(b, a);
     alias[b] = a;
-    if (patch[a] == -1) patch[a] = patch[b];
+    if (patch[a] == -1 || into_vertex) patch[a] = patch[b];
+    if (into_vertex) line[a] = line[b];
     ++stats.collapsed;
   }
 
