@@ -331,7 +331,8 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
                  {"refused_topology", im.refused_topology},
                  {"refused_geometry", im.refused_geometry},
                  {"removed_cells", im.removed_cells},
-                 {"pyramids_to_tets", im.pyramids_to_tets}}},
+                 {"pyramids_to_tets", im.pyramids_to_tets},
+                 {"pyramids_split", im.pyramids_split}}},
                {"patches", patches},
                {"outlet_extension_mm", significant(r.extension.length_mm)},
                {"quality_before", quality_json(r.before)},
@@ -397,9 +398,9 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
   if (job.improve)
     s += fmt::format(
         "  improved  {} short edges collapsed ({} refused), {} cells removed, {} "
-        "pyramids → tets\n",
+        "pyramids → tets, {} split\n",
         r.improvement.collapsed, r.improvement.refused_topology + r.improvement.refused_geometry,
-        r.improvement.removed_cells, r.improvement.pyramids_to_tets);
+        r.improvement.removed_cells, r.improvement.pyramids_to_tets, r.improvement.pyramids_split);
   if (job.relocate)
     s += fmt::format(
         "  relocated {} nodes, removed {} edges and {} wall slivers: cells below target {} → {}, "

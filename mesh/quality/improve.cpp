@@ -41,6 +41,7 @@ class Incidence {
     if (const auto it = extra_.find(n); it != extra_.end())
       for (auto i : it->second) f(i);
   }
+  void add(NodeId n, std::int32_t item) { extra_[n].push_back(item); }
   void merge(NodeId from, NodeId into) {
     auto& dst = extra_[into];
     for_each(from, [&](std::int32_t i) { dst.push_back(i); });
@@ -222,6 +223,8 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     out.erase(std::unique(out.begin(), out.end()), out.end());
   };
   std::vector<NodeId> neighbours_a, neighbours_b, allowed;
+  std::vector<std::tuple<std::int32_t, Cell, char>> saved_cells;  // as before a split
+  std::vector<std::pair<std::int32_t, Face>> saved_faces;
   for (const auto& [len0, a0, b0] : edges) {
     NodeId a = find(a0), b = find(b0);
     if (a == b || (x[a] - x[b]).norm() >= min_edge) continue;
@@ -232,12 +235,13 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     auto movable = [&](NodeId n) { return !locked[n] && patch[n] != -2; };
     // p and q on the line between the same two patches.
     auto one_line = [&](NodeId p, NodeId q) { return line[p][0] >= 0 && line[p] == line[q]; };
-    // Two nodes of one line, joined by an edge of that line, merge along it at one of them (not
-    // a hexahedron's): a cut plane's rim keeps its shape.
+    // Two nodes of one line joined by a boundary edge merge at one of them (not a hexahedron's):
+    // along the line where the edge is the line's, or across the ear of a patch that a chord
+    // cuts off. A cut plane's rim keeps its shape.
     bool along_line = false;
     if (one_line(a, b) && !(locked[a] && locked[b])) {
-      // The distinct boundary faces on edge ab (a's list may hold a merged face twice); a third
-      // one already rules the edge out.
+      // The distinct boundary faces on edge ab (a's list may hold a merged face twice): two on a
+      // boundary edge; a third one already rules the edge out.
       std::array<std::int32_t, 3> on_edge{};
       int count = 0;
       node_faces.for_each(a, [&](std::int32_t f) {
@@ -246,8 +250,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
           return;
         on_edge[static_cast<std::size_t>(count++)] = f;
       });
-      along_line = count == 2 && std::minmax(faces[on_edge[0]].patch, faces[on_edge[1]].patch) ==
-                                     std::minmax(line[a][0], line[a][1]);
+      along_line = count == 2;
       if (along_line && locked[b]) std::swap(a, b);
     }
     // A node of a line between patches merges into a hexahedron node on one of those patches
@@ -274,25 +277,99 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
       ++stats.refused_topology;
       continue;
     }
-    if (patch[a] == -2 && patch[b] == -1) {
-      ++stats.refused_topology;  // an interior node onto a patch line: keep it simple
-      continue;
-    }
     const bool midpoint = movable(a) && movable(b) && patch[a] == patch[b];
     const Vec target = midpoint ? Vec(0.5 * (x[a] + x[b])) : x[a];
 
-    around_a.clear();
-    around_b.clear();
-    node_cells.for_each(a, [&](std::int32_t c) {
-      if (cells[c].size && has(cells[c], a)) around_a.push_back(c);
-    });
-    node_cells.for_each(b, [&](std::int32_t c) {
-      if (cells[c].size && has(cells[c], b)) around_b.push_back(c);
-    });
-    std::sort(around_a.begin(), around_a.end());
-    around_a.erase(std::unique(around_a.begin(), around_a.end()), around_a.end());
-    std::sort(around_b.begin(), around_b.end());
-    around_b.erase(std::unique(around_b.begin(), around_b.end()), around_b.end());
+    auto gather = [&](NodeId n, std::vector<std::int32_t>& around) {
+      around.clear();
+      node_cells.for_each(n, [&](std::int32_t c) {
+        if (cells[c].size && has(cells[c], n)) around.push_back(c);
+      });
+      std::sort(around.begin(), around.end());
+      around.erase(std::unique(around.begin(), around.end()), around.end());
+    };
+    gather(a, around_a);
+    gather(b, around_b);
+    // A pyramid with ab as a lateral edge is split first: into two tetrahedra along the base
+    // diagonal through its base corner on ab, and so is what lies across its base (a pyramid, or
+    // the boundary's quadrilateral; not a hexahedron). Undone if the collapse is refused.
+    saved_cells.clear();
+    saved_faces.clear();
+    const std::size_t cells_before_split = cells.size(), faces_before_split = faces.size();
+    auto add_cell = [&](const Cell& c) {
+      cells.push_back(c);
+      changed.push_back(1);
+      for (int k = 0; k < c.size; ++k)
+        node_cells.add(c.v[k], static_cast<std::int32_t>(cells.size() - 1));
+    };
+    // Item `slot` (a pyramid or a quadrilateral) split along the diagonal through `corner`: the
+    // half with the corner's successor stays in the slot, the other is added.
+    auto split_cell = [&](std::int32_t slot, NodeId corner) {
+      const Cell p = cells[slot];
+      saved_cells.push_back({slot, p, changed[slot]});
+      const int k = static_cast<int>(std::find(p.v.begin(), p.v.begin() + 4, corner) - p.v.begin());
+      const NodeId v0 = p.v[k], v1 = p.v[(k + 1) % 4], v2 = p.v[(k + 2) % 4], v3 = p.v[(k + 3) % 4];
+      cells[slot] = {4, {v0, v1, v2, p.v[4]}};
+      changed[slot] = 1;
+      add_cell({4, {v0, v2, v3, p.v[4]}});
+    };
+    auto split_face = [&](std::int32_t slot, NodeId corner) {
+      const Face q = faces[slot];
+      saved_faces.push_back({slot, q});
+      const int k = static_cast<int>(std::find(q.v.begin(), q.v.begin() + 4, corner) - q.v.begin());
+      const NodeId v0 = q.v[k], v1 = q.v[(k + 1) % 4], v2 = q.v[(k + 2) % 4], v3 = q.v[(k + 3) % 4];
+      faces[slot] = {3, {v0, v1, v2, 0}, q.patch};
+      faces.push_back({3, {v0, v2, v3, 0}, q.patch});
+      for (NodeId n : {v0, v2, v3}) node_faces.add(n, static_cast<std::int32_t>(faces.size() - 1));
+    };
+    bool split_refused = false;
+    for (auto c : around_b) {
+      const Cell p = cells[c];
+      if (p.size != 5 || !has(p, a) || (p.v[4] != a && p.v[4] != b)) continue;
+      const NodeId corner = p.v[4] == a ? b : a;
+      auto holds_base = [&](const auto& item) {
+        int count = 0;
+        for (int k = 0; k < 4; ++k) count += has(item, p.v[k]);
+        return count == 4;
+      };
+      std::int32_t across = -1, quad = -1;
+      node_cells.for_each(corner, [&](std::int32_t q) {
+        if (q != c && cells[q].size && holds_base(cells[q])) across = q;
+      });
+      node_faces.for_each(corner, [&](std::int32_t f) {
+        if (faces[f].size == 4 && holds_base(faces[f])) quad = f;
+      });
+      const bool base_across =
+          across >= 0 && cells[across].size == 5 &&
+          std::find(p.v.begin(), p.v.begin() + 4, cells[across].v[4]) == p.v.begin() + 4;
+      if (across >= 0 ? !base_across : quad < 0) {
+        split_refused = true;
+        break;
+      }
+      split_cell(c, corner);
+      if (across >= 0)
+        split_cell(across, corner);
+      else
+        split_face(quad, corner);
+    }
+    auto undo_split = [&]() {
+      for (const auto& [slot, cell, was_changed] : saved_cells) {
+        cells[slot] = cell;
+        changed[slot] = was_changed;
+      }
+      for (const auto& [slot, face] : saved_faces) faces[slot] = face;
+      for (std::size_t c = cells_before_split; c < cells.size(); ++c) cells[c].size = 0;
+      for (std::size_t f = faces_before_split; f < faces.size(); ++f) faces[f].size = 0;
+    };
+    if (split_refused) {
+      undo_split();
+      ++stats.refused_topology;
+      continue;
+    }
+    if (!saved_cells.empty()) {
+      gather(a, around_a);
+      gather(b, around_b);
+    }
 
     // Topology: the cells on the edge, the pyramid rules, and the link condition.
     bool ok = true;
@@ -396,6 +473,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
           ok = false;
     }
     if (!ok) {
+      undo_split();
       ++stats.refused_topology;
       continue;
     }
@@ -466,6 +544,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     if (!shaped) {
       x[a] = xa;
       x[b] = xb;
+      undo_split();
       ++stats.refused_geometry;
       continue;
     }
@@ -490,6 +569,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     if (patch[a] == -1 || into_vertex) patch[a] = patch[b];
     if (into_vertex) line[a] = line[b];
     ++stats.collapsed;
+    stats.pyramids_split += saved_cells.size();
   }
 
   // Back to the mesh arrays.

@@ -1,9 +1,11 @@
 #pragma once
 // Mesh quality improvement (dissertation 3.3): short edges of the tetrahedra and pyramids are
 // collapsed to their midpoints (a tiny boundary polygon disappears edge by edge), with the
-// pyramid rules of 3.3: a collapsed base edge turns the pyramid into a tetrahedron, a lateral
-// edge is never collapsed. Hexahedra and their nodes are never touched. A collapse is made only
-// if it keeps the mesh a conforming, watertight manifold and every changed cell positive.
+// pyramid rules of 3.3: a collapsed base edge turns the pyramid into a tetrahedron; a lateral
+// edge goes only once its pyramid is split into two tetrahedra, with what lies across its base (a
+// pyramid or a boundary quadrilateral; never where a hexahedron does). Hexahedra and their nodes
+// are never touched. A collapse is made only if it keeps the mesh a conforming, watertight
+// manifold and every changed cell positive.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -26,6 +28,7 @@ struct ImproveStats {
   std::size_t refused_geometry = 0;  // would invert or flatten a cell or fold the boundary
   std::size_t removed_cells = 0;
   std::size_t pyramids_to_tets = 0;
+  std::size_t pyramids_split = 0;  // into two tetrahedra, for a collapse of a lateral edge
   double seconds = 0.0;
 };
 
