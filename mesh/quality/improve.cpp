@@ -223,7 +223,31 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     out.erase(std::unique(out.begin(), out.end()), out.end());
   };
   std::vector<NodeId> neighbours_a, neighbours_b, allowed;
-  std::vector<std::tuple<std::int32_t, Cell, char>> saved_cells;  // as before a split
+  // The nodes joined to n by an edge of its line: an edge whose boundary faces are of both the
+  // line's patches.
+  auto line_neighbours = [&](NodeId n, std::vector<NodeId>& out) {
+    out.clear();
+    node_faces.for_each(n, [&](std::int32_t f) {
+      const Face& face = faces[f];
+      if (!face.size || !has(face, n)) return;
+      for (int k = 0; k < face.size; ++k) {
+        if (face.v[k] != n) continue;
+        for (const NodeId m :
+             {face.v[(k + 1) % face.size], face.v[(k + face.size - 1) % face.size]}) {
+          bool first = false, second = false;
+          node_faces.for_each(n, [&](std::int32_t g) {
+            if (!faces[g].size || !has_edge(faces[g], n, m)) return;
+            first = first || faces[g].patch == line[n][0];
+            second = second || faces[g].patch == line[n][1];
+          });
+          if (first && second && std::find(out.begin(), out.end(), m) == out.end())
+            out.push_back(m);
+        }
+      }
+    });
+  };
+  // A split pyramid: its slot, itself, its slot's changed flag, the slot of its second half.
+  std::vector<std::tuple<std::int32_t, Cell, char, std::int32_t>> saved_cells;
   std::vector<std::pair<std::int32_t, Face>> saved_faces;
   for (const auto& [len0, a0, b0] : edges) {
     NodeId a = find(a0), b = find(b0);
@@ -251,6 +275,17 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
         on_edge[static_cast<std::size_t>(count++)] = f;
       });
       along_line = count == 2;
+      // A chord (both faces one patch's) only where it cuts off an ear: a and b have a common
+      // neighbour along the line, the ear's tip. Between two stretches of the line it would
+      // pinch the patch.
+      if (along_line && faces[on_edge[0]].patch == faces[on_edge[1]].patch) {
+        line_neighbours(a, neighbours_a);
+        line_neighbours(b, neighbours_b);
+        bool ear = false;
+        for (NodeId n : neighbours_a)
+          ear = ear || std::find(neighbours_b.begin(), neighbours_b.end(), n) != neighbours_b.end();
+        along_line = ear;
+      }
       if (along_line && locked[b]) std::swap(a, b);
     }
     // A node of a line between patches merges into a hexahedron node on one of those patches
@@ -306,7 +341,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     // half with the corner's successor stays in the slot, the other is added.
     auto split_cell = [&](std::int32_t slot, NodeId corner) {
       const Cell p = cells[slot];
-      saved_cells.push_back({slot, p, changed[slot]});
+      saved_cells.push_back({slot, p, changed[slot], static_cast<std::int32_t>(cells.size())});
       const int k = static_cast<int>(std::find(p.v.begin(), p.v.begin() + 4, corner) - p.v.begin());
       const NodeId v0 = p.v[k], v1 = p.v[(k + 1) % 4], v2 = p.v[(k + 2) % 4], v3 = p.v[(k + 3) % 4];
       cells[slot] = {4, {v0, v1, v2, p.v[4]}};
@@ -353,7 +388,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
         split_face(quad, corner);
     }
     auto undo_split = [&]() {
-      for (const auto& [slot, cell, was_changed] : saved_cells) {
+      for (const auto& [slot, cell, was_changed, half] : saved_cells) {
         cells[slot] = cell;
         changed[slot] = was_changed;
       }
@@ -520,6 +555,12 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
         const Cell& cell = cells[c];
         if (has(cell, b)) continue;
         if (cell.size == 8 || !acceptable(cell, cell)) shaped = false;
+      }
+    // The halves of a split pyramid, measured against the pyramid (one may touch neither a nor b).
+    for (const auto& [slot, pyramid, was_changed, half] : saved_cells)
+      for (const std::int32_t c : {slot, half}) {
+        const Cell after = collapsed(cells[c], a, b);
+        if (after.size && !acceptable(pyramid, after)) shaped = false;
       }
     if (shaped) {
       auto flips = [&](NodeId n) {

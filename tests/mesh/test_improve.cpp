@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <set>
 #include <span>
@@ -144,6 +145,18 @@ TEST(Improve, AnAdultNarisRimKeepsNoShortEdge) {
       r.improvement.refused_topology, r.improvement.refused_geometry);
   EXPECT_EQ(short_rim.size(), 0u);
   EXPECT_EQ(short_to_vertex.size(), 0u);
+  // The rim stays one closed line: every rim node on exactly two of its edges (a chord's collapse
+  // between two stretches of it would pinch the inlet at a node with four).
+  std::map<std::pair<NodeId, NodeId>, int> edge_sides;
+  for_each_boundary_face(m, [&](std::span<const NodeId> f, std::int32_t p) {
+    for (std::size_t k = 0; k < f.size(); ++k)
+      edge_sides[std::minmax(f[k], f[(k + 1) % f.size()])] |= p == wall ? 1 : p == inlet ? 2 : 4;
+  });
+  std::map<NodeId, int> rim_edges;
+  for (const auto& [e, sides] : edge_sides)
+    if (sides == 3) ++rim_edges[e.first], ++rim_edges[e.second];
+  ASSERT_FALSE(rim_edges.empty());
+  for (const auto& [node, count] : rim_edges) EXPECT_EQ(count, 2) << "rim node " << node;
 }
 
 TEST(Improve, RandomFieldsStayConformingWatertightAndPositive) {
