@@ -347,6 +347,7 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
         {"worst_score_after", significant(r.relocation.worst_after)},
         {"nodes_moved", r.relocation.nodes_moved},
         {"moves", r.relocation.moves},
+        {"rim_slides", r.relocation.rim_slides},
         {"slivers_removed", r.relocation.slivers_removed},
         {"edges_removed", r.relocation.edges_removed},
         {"largest_surface_offset_mm", significant(r.relocation.largest_surface_offset)},

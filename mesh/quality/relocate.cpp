@@ -18,7 +18,9 @@ constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
 
 // surface: slides on the wall's level zero; plane: moves in its flat patch (a cut plane, a box
 // side); rim: on the line where the wall meets a flat patch (in the plane, on the level zero).
-enum class Freedom : std::uint8_t { fixed, interior, surface, plane, rim };
+// along: a rim node where the wall's field is flat (no level zero or gradient to follow) moves
+// along the rim itself, towards either of its two neighbours on it.
+enum class Freedom : std::uint8_t { fixed, interior, surface, plane, rim, along };
 
 struct Plane {
   Vec normal = Vec::Zero();  // unit
@@ -315,6 +317,44 @@ class Relocator {
     const std::size_t tris = mesh.boundary_tris.size();
     node_faces_.build(n_nodes, tris + mesh.boundary_quads.size(),
                       [&](std::size_t f) { return face(f); });
+    // Rim nodes in a voxel whose corners are all on one side of the wall's level zero.
+    std::vector<std::pair<NodeId, std::int32_t>> uses;  // (face neighbour, face patch)
+    for (std::size_t n = 0; n < n_nodes; ++n) {
+      if (freedom_[n] != Freedom::rim) continue;
+      double value;
+      Vec gradient;
+      if (wall->evaluate(mesh.nodes[n], value, gradient) && gradient.squaredNorm() > 0.0) continue;
+      uses.clear();
+      for (auto f : node_faces_.of(static_cast<NodeId>(n))) {
+        const auto v = face(static_cast<std::size_t>(f));
+        const std::size_t i =
+            static_cast<std::size_t>(std::find(v.begin(), v.end(), n) - v.begin());
+        const std::int32_t p = static_cast<std::size_t>(f) < tris
+                                   ? mesh.boundary_tri_patch[static_cast<std::size_t>(f)]
+                                   : mesh.boundary_quad_patch[static_cast<std::size_t>(f) - tris];
+        uses.push_back({v[(i + 1) % v.size()], p});
+        uses.push_back({v[(i + v.size() - 1) % v.size()], p});
+      }
+      std::sort(uses.begin(), uses.end());
+      std::array<NodeId, 2> ends{};
+      int count = 0;
+      for (std::size_t k = 0; k < uses.size();) {
+        std::size_t j = k;
+        bool on_wall = false, on_plane = false;
+        for (; j < uses.size() && uses[j].first == uses[k].first; ++j) {
+          on_wall = on_wall || walled(uses[j].second);
+          on_plane = on_plane || uses[j].second == plane_[n];
+        }
+        if (on_wall && on_plane && count < 3) {
+          if (count < 2) ends[static_cast<std::size_t>(count)] = uses[k].first;
+          ++count;
+        }
+        k = j;
+      }
+      if (count != 2) continue;
+      freedom_[n] = Freedom::along;
+      rim_ends_[static_cast<NodeId>(n)] = ends;
+    }
   }
 
   RelocateStats run(int sweeps, std::vector<std::int64_t>* unchanged_from) {
@@ -360,6 +400,7 @@ class Relocator {
     for (std::size_t n = 0; n < moved.size(); ++n) {
       if (!moved[n]) continue;
       ++stats.nodes_moved;
+      if (freedom_[n] == Freedom::along) ++stats.rim_slides;
       if (unchanged_from)
         for (auto c : node_cells_.of(static_cast<NodeId>(n)))
           (*unchanged_from)[static_cast<std::size_t>(c)] = -1;
@@ -443,6 +484,7 @@ class Relocator {
     double best = worst_around(n, x, -INFINITY, around[0]);
     if (best >= 1.0) return false;
     const Freedom freedom = freedom_[n];
+    if (freedom == Freedom::along) return slide_along_rim(n, best, around[0]);
     const Plane* plane = plane_[n] >= 0 ? &planes_[static_cast<std::size_t>(plane_[n])] : nullptr;
     double h = 0.25 * length;
     bool moved = false;
@@ -550,13 +592,49 @@ class Relocator {
     return moved;
   }
 
+  // The position of n that maximizes the lowest score of its cells on the rim's two edges at n
+  // (at most 0.45 of either), in n's plane: a search on the fraction of the way to either end.
+  bool slide_along_rim(NodeId n, double best, std::int32_t first) {
+    const Vec origin = mesh_.nodes[n];
+    const auto [towards, away] = rim_ends_.at(n);
+    const Vec forward = mesh_.nodes[towards] - origin, backward = mesh_.nodes[away] - origin;
+    const Plane& plane = planes_[static_cast<std::size_t>(plane_[n])];
+    auto position = [&](double s) {
+      return plane.through(origin + (s >= 0.0 ? s * forward : -s * backward), origin);
+    };
+    double s = 0.0;
+    bool moved = false;
+    for (double h = 0.25; h > 1e-3;) {
+      bool improved = false;
+      for (const double t : {std::min(s + h, 0.45), std::max(s - h, -0.45)}) {
+        const Vec p = position(t);
+        if (t == s || !faces_keep_orientation(n, p)) continue;
+        const double score = worst_around(n, p, best, first);
+        if (score > best + 1e-9 * std::abs(best) + 1e-12) {
+          best = score;
+          s = t;
+          improved = true;
+        }
+      }
+      if (improved) {
+        moved = true;
+        if (best >= 1.0) break;
+      } else {
+        h *= 0.5;
+      }
+    }
+    if (moved) mesh_.nodes[n] = position(s);
+    return moved;
+  }
+
   HybridMesh& mesh_;
   Cells cells_;
   const LevelSet* wall_;
   Scorer score_;
   std::vector<Freedom> freedom_;
   std::vector<std::int32_t> plane_;  // the flat patch of plane and rim nodes
-  std::vector<Plane> planes_;        // of each patch
+  std::unordered_map<NodeId, std::array<NodeId, 2>> rim_ends_;  // of `along` nodes
+  std::vector<Plane> planes_;                                   // of each patch
   NodeIncidence node_cells_, node_faces_;
   std::vector<float> score_of_;  // of every cell, as the nodes stand
   std::vector<double> scores_;   // of the cells around the node being moved

@@ -29,6 +29,7 @@ struct RelocateStats {
   std::size_t cells_below_after = 0;
   std::size_t nodes_moved = 0;  // distinct nodes
   std::size_t moves = 0;
+  std::size_t rim_slides = 0;  // rim nodes moved along the rim (where the wall's field is flat)
   std::size_t slivers_removed = 0;  // wall tetrahedra that no move could lift
   std::size_t edges_removed = 0;    // interior edges of cells below target, removed by flips
   double worst_before = 0.0;        // lowest score
