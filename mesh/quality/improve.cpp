@@ -223,6 +223,16 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     out.erase(std::unique(out.begin(), out.end()), out.end());
   };
   std::vector<NodeId> neighbours_a, neighbours_b, allowed;
+  // The distinct boundary faces on edge p–q (a node's list may hold a merged face twice).
+  std::vector<std::int32_t> on_edge, around_edge;
+  auto edge_faces = [&](NodeId p, NodeId q, std::vector<std::int32_t>& out) {
+    out.clear();
+    node_faces.for_each(p, [&](std::int32_t f) {
+      if (faces[f].size && has_edge(faces[f], p, q) &&
+          std::find(out.begin(), out.end(), f) == out.end())
+        out.push_back(f);
+    });
+  };
   // The nodes joined to n by an edge of its line: an edge whose boundary faces are of both the
   // line's patches.
   auto line_neighbours = [&](NodeId n, std::vector<NodeId>& out) {
@@ -234,12 +244,12 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
         if (face.v[k] != n) continue;
         for (const NodeId m :
              {face.v[(k + 1) % face.size], face.v[(k + face.size - 1) % face.size]}) {
+          edge_faces(n, m, around_edge);
           bool first = false, second = false;
-          node_faces.for_each(n, [&](std::int32_t g) {
-            if (!faces[g].size || !has_edge(faces[g], n, m)) return;
+          for (auto g : around_edge) {
             first = first || faces[g].patch == line[n][0];
             second = second || faces[g].patch == line[n][1];
-          });
+          }
           if (first && second && std::find(out.begin(), out.end(), m) == out.end())
             out.push_back(m);
         }
@@ -264,17 +274,9 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     // cuts off. A cut plane's rim keeps its shape.
     bool along_line = false;
     if (one_line(a, b) && !(locked[a] && locked[b])) {
-      // The distinct boundary faces on edge ab (a's list may hold a merged face twice): two on a
-      // boundary edge; a third one already rules the edge out.
-      std::array<std::int32_t, 3> on_edge{};
-      int count = 0;
-      node_faces.for_each(a, [&](std::int32_t f) {
-        if (count == 3 || !faces[f].size || !has_edge(faces[f], a, b) ||
-            std::find(on_edge.begin(), on_edge.begin() + count, f) != on_edge.begin() + count)
-          return;
-        on_edge[static_cast<std::size_t>(count++)] = f;
-      });
-      along_line = count == 2;
+      // Two faces on a boundary edge; a third one rules the edge out.
+      edge_faces(a, b, on_edge);
+      along_line = on_edge.size() == 2;
       // A chord (both faces one patch's) only where it cuts off an ear: a and b have a common
       // neighbour along the line, the ear's tip. Between two stretches of the line it would
       // pinch the patch.
