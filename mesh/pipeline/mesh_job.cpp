@@ -332,7 +332,8 @@ void write_mesh_outputs(const MeshJob& job, MeshJobResult& r) {
                  {"refused_geometry", im.refused_geometry},
                  {"removed_cells", im.removed_cells},
                  {"pyramids_to_tets", im.pyramids_to_tets},
-                 {"pyramids_split", im.pyramids_split}}},
+                 {"pyramids_split", im.pyramids_split},
+                 {"vertices_warped", im.vertices_warped}}},
                {"patches", patches},
                {"outlet_extension_mm", significant(r.extension.length_mm)},
                {"quality_before", quality_json(r.before)},
@@ -399,9 +400,10 @@ std::string format_mesh_summary(const MeshJob& job, const MeshJobResult& r) {
   if (job.improve)
     s += fmt::format(
         "  improved  {} short edges collapsed ({} refused), {} cells removed, {} "
-        "pyramids → tets, {} split\n",
+        "pyramids → tets, {} split, {} lattice vertices warped onto the boundary\n",
         r.improvement.collapsed, r.improvement.refused_topology + r.improvement.refused_geometry,
-        r.improvement.removed_cells, r.improvement.pyramids_to_tets, r.improvement.pyramids_split);
+        r.improvement.removed_cells, r.improvement.pyramids_to_tets, r.improvement.pyramids_split,
+        r.improvement.vertices_warped);
   if (job.relocate)
     s += fmt::format(
         "  relocated {} nodes, removed {} edges and {} wall slivers: cells below target {} → {}, "

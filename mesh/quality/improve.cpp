@@ -81,6 +81,15 @@ double cell_shape(const Cell& c, const std::vector<Vec>& x) {
   if (c.size == 4)
     return std::min(
         {corner(0, 1, 2, 3), corner(1, 2, 0, 3), corner(2, 0, 1, 3), corner(3, 0, 2, 1)});
+  if (c.size == 8) {
+    // Its eight corners (VTK order), a cube's at 1; corner() scales a tetrahedron's to 1.
+    double worst = INFINITY;
+    for (const auto& k : {std::array{0, 1, 3, 4}, std::array{1, 2, 0, 5}, std::array{2, 3, 1, 6},
+                          std::array{3, 0, 2, 7}, std::array{4, 7, 5, 0}, std::array{5, 4, 6, 1},
+                          std::array{6, 5, 7, 2}, std::array{7, 6, 4, 3}})
+      worst = std::min(worst, corner(k[0], k[1], k[2], k[3]) / std::numbers::sqrt2);
+    return worst;
+  }
   // Pyramid: base corners, and every sub-tetrahedron of both base diagonals must be positive.
   const auto& v = c.v;
   const double tets = std::min(
@@ -262,10 +271,12 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
   for (const auto& [len0, a0, b0] : edges) {
     NodeId a = find(a0), b = find(b0);
     if (a == b || (x[a] - x[b]).norm() >= min_edge) continue;
-    // Which node survives (a), and where. Hexahedron nodes never move; nodes on a line between
-    // patches only along it (below). A movable node merges into a fixed one at the fixed
-    // position; two movable nodes meet at their midpoint. A wall node may merge into a fixed
-    // interior node, which then joins the wall (the wall moves by less than the edge).
+    // Which node survives (a), and where. Nodes on a line between patches move only along it
+    // (below). A movable node merges into a fixed one at the fixed position; two movable nodes
+    // meet at their midpoint. A boundary node merging into a hexahedron's interior node (a lattice
+    // vertex) takes it onto the boundary where the boundary node stands: the wall stays on its
+    // surface, and the hexahedra at the vertex warp by less than the edge (the lattice warp of
+    // isosurface stuffing). Hexahedra without such a vertex never change.
     auto movable = [&](NodeId n) { return !locked[n] && patch[n] != -2; };
     // p and q on the line between the same two patches.
     auto one_line = [&](NodeId p, NodeId q) { return line[p][0] >= 0 && line[p] == line[q]; };
@@ -315,7 +326,8 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
       continue;
     }
     const bool midpoint = movable(a) && movable(b) && patch[a] == patch[b];
-    const Vec target = midpoint ? Vec(0.5 * (x[a] + x[b])) : x[a];
+    const bool warp = locked[a] && patch[a] == -1 && !locked[b] && patch[b] >= 0;
+    const Vec target = midpoint ? Vec(0.5 * (x[a] + x[b])) : warp ? x[b] : x[a];
 
     auto gather = [&](NodeId n, std::vector<std::int32_t>& around) {
       around.clear();
@@ -556,7 +568,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
       for (auto c : around_a) {
         const Cell& cell = cells[c];
         if (has(cell, b)) continue;
-        if (cell.size == 8 || !acceptable(cell, cell)) shaped = false;
+        if (!acceptable(cell, cell)) shaped = false;
       }
     // The halves of a split pyramid, measured against the pyramid (one may touch neither a nor b).
     for (const auto& [slot, pyramid, was_changed, half] : saved_cells)
@@ -613,6 +625,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
     if (into_vertex) line[a] = line[b];
     ++stats.collapsed;
     stats.pyramids_split += saved_cells.size();
+    stats.vertices_warped += warp;
   }
 
   // Back to the mesh arrays.

@@ -3,7 +3,8 @@
 // collapsed to their midpoints (a tiny boundary polygon disappears edge by edge), with the
 // pyramid rules of 3.3: a collapsed base edge turns the pyramid into a tetrahedron; a lateral
 // edge goes only once its pyramid is split into two tetrahedra, with what lies across its base (a
-// pyramid or a boundary quadrilateral; never where a hexahedron does). Hexahedra and their nodes
+// pyramid or a boundary quadrilateral; never where a hexahedron does). A boundary node merging
+// into a lattice vertex moves the vertex onto the boundary (its hexahedra warp); other hexahedra
 // are never touched. A collapse is made only if it keeps the mesh a conforming, watertight
 // manifold and every changed cell positive.
 #include <cstddef>
@@ -28,7 +29,8 @@ struct ImproveStats {
   std::size_t refused_geometry = 0;  // would invert or flatten a cell or fold the boundary
   std::size_t removed_cells = 0;
   std::size_t pyramids_to_tets = 0;
-  std::size_t pyramids_split = 0;  // into two tetrahedra, for a collapse of a lateral edge
+  std::size_t pyramids_split = 0;   // into two tetrahedra, for a collapse of a lateral edge
+  std::size_t vertices_warped = 0;  // lattice vertices moved onto the boundary by a collapse
   double seconds = 0.0;
 };
 

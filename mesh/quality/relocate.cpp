@@ -145,8 +145,8 @@ bool project(const LevelSet& wall, Vec& p, double reach, const Plane* plane = nu
 
 // The plane of each patch on which at least 90 % of its nodes lie (to 1e-9 of the mesh's size);
 // others get a zero normal. A cut plane's isopoints lie on it, but the collapses of 3.3 may merge
-// one into a hexahedron's node up to a fifth of a voxel off it. The plane is the one most nodes
-// lie on; the nodes off it stay.
+// a rim node into a lattice vertex on the wall, off it. The plane is the one most nodes lie on;
+// the nodes off it stay.
 std::vector<Plane> flat_patches(const HybridMesh& mesh) {
   const std::size_t n_patches = mesh.patch_names.size();
   std::vector<Vec> area(n_patches, Vec::Zero());
