@@ -540,8 +540,10 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
       // A cell left with another short edge at the merged node that a collapse may take (not a
       // pyramid's lateral edge, the other end movable or on a's line) is the next collapse's: a
       // cluster of isopoints near one lattice vertex (a cut plane passing it) goes edge by edge.
+      // Not after a warp: its flat cells lie on the wall, where the next collapse is often
+      // refused, and would stay flat.
       const auto& edges_of = cell_edges(after.size);
-      for (std::size_t k = 0; k < edges_of.size(); ++k) {
+      for (std::size_t k = 0; k < edges_of.size() && !warp; ++k) {
         const NodeId p = after.v[edges_of[k][0]], q = after.v[edges_of[k][1]];
         if (p != a && q != a) continue;
         const NodeId other = p == a ? q : p;
