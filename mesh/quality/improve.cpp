@@ -71,7 +71,7 @@ double tet6(const Vec& a, const Vec& b, const Vec& c, const Vec& d) {
   return (b - a).cross(c - a).dot(d - a);
 }
 
-// Scaled Jacobian of a tet or pyramid (the improved cells), ≤ 0 when inverted.
+// Scaled Jacobian of a tetrahedron, pyramid or hexahedron, ≤ 0 when inverted.
 double cell_shape(const Cell& c, const std::vector<Vec>& x) {
   auto corner = [&](int o, int a, int b, int d) {
     const Vec e1 = x[c.v[a]] - x[c.v[o]], e2 = x[c.v[b]] - x[c.v[o]], e3 = x[c.v[d]] - x[c.v[o]];

@@ -132,8 +132,8 @@ TEST(Improve, AClusterWhereACutPlanePassesALatticeVertexCollapses) {
 // the oblique plane the segmentation finds. Where the plane passes a lattice vertex on the wall,
 // its rim (where the inlet meets the wall) gets nodes hundredths of a millimetre apart. Rim nodes
 // joined by a rim edge merge along it, and a rim node merges into a hexahedron node of the
-// inlet or the wall next to it (one a collapse made a boundary node); only pyramids' lateral
-// edges, which 3.3 never collapses, may stay that short.
+// inlet or the wall next to it (one a warp made a boundary node); only pyramids' lateral edges,
+// which 3.3 never collapses, may stay that short.
 TEST(Improve, AnAdultNarisRimKeepsNoShortEdge) {
   const std::filesystem::path ct_file =
       std::filesystem::path(NARIS_SHARED_DATA) / "nasalseg" / "P055_img.nrrd";
