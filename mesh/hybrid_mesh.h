@@ -75,6 +75,21 @@ inline constexpr std::array<std::array<int, 2>, 12> kHexEdges = {{{0, 1},
                                                                   {1, 5},
                                                                   {2, 6},
                                                                   {3, 7}}};
+// The corners of each cell type for the scaled Jacobian: a node, then its three edge neighbours
+// in right-handed order (the pyramid's apex has none).
+inline constexpr std::array<std::array<int, 4>, 4> kTetCorners = {
+    {{0, 1, 2, 3}, {1, 2, 0, 3}, {2, 0, 1, 3}, {3, 0, 2, 1}}};
+inline constexpr std::array<std::array<int, 4>, 4> kPyramidCorners = {
+    {{0, 1, 3, 4}, {1, 2, 0, 4}, {2, 3, 1, 4}, {3, 0, 2, 4}}};
+inline constexpr std::array<std::array<int, 4>, 8> kHexCorners = {{{0, 1, 3, 4},
+                                                                   {1, 2, 0, 5},
+                                                                   {2, 3, 1, 6},
+                                                                   {3, 0, 2, 7},
+                                                                   {4, 7, 5, 0},
+                                                                   {5, 4, 6, 1},
+                                                                   {6, 5, 7, 2},
+                                                                   {7, 6, 4, 3}}};
+
 // The edges of a cell with 4, 5 or 8 nodes.
 inline std::span<const std::array<int, 2>> cell_edges(int nodes) {
   if (nodes == 4) return kTetEdges;

@@ -73,30 +73,26 @@ double tet6(const Vec& a, const Vec& b, const Vec& c, const Vec& d) {
 
 // Scaled Jacobian of a tetrahedron, pyramid or hexahedron, ≤ 0 when inverted.
 double cell_shape(const Cell& c, const std::vector<Vec>& x) {
-  auto corner = [&](int o, int a, int b, int d) {
-    const Vec e1 = x[c.v[a]] - x[c.v[o]], e2 = x[c.v[b]] - x[c.v[o]], e3 = x[c.v[d]] - x[c.v[o]];
-    const double norms = e1.norm() * e2.norm() * e3.norm();
-    return norms > 0.0 ? e1.cross(e2).dot(e3) / norms * std::numbers::sqrt2 : -1.0;
-  };
-  if (c.size == 4)
-    return std::min(
-        {corner(0, 1, 2, 3), corner(1, 2, 0, 3), corner(2, 0, 1, 3), corner(3, 0, 2, 1)});
-  if (c.size == 8) {
-    // Its eight corners (VTK order), a cube's at 1; corner() scales a tetrahedron's to 1.
+  // The lowest corner, scaled so that the regular tetrahedron's and the cube's are 1.
+  auto lowest = [&](const auto& corners, double scale) {
     double worst = INFINITY;
-    for (const auto& k : {std::array{0, 1, 3, 4}, std::array{1, 2, 0, 5}, std::array{2, 3, 1, 6},
-                          std::array{3, 0, 2, 7}, std::array{4, 7, 5, 0}, std::array{5, 4, 6, 1},
-                          std::array{6, 5, 7, 2}, std::array{7, 6, 4, 3}})
-      worst = std::min(worst, corner(k[0], k[1], k[2], k[3]) / std::numbers::sqrt2);
+    for (const auto& k : corners) {
+      const Vec e1 = x[c.v[k[1]]] - x[c.v[k[0]]], e2 = x[c.v[k[2]]] - x[c.v[k[0]]],
+                e3 = x[c.v[k[3]]] - x[c.v[k[0]]];
+      const double norms = e1.norm() * e2.norm() * e3.norm();
+      worst = std::min(worst, norms > 0.0 ? e1.cross(e2).dot(e3) / norms * scale : -1.0);
+    }
     return worst;
-  }
+  };
+  if (c.size == 4) return lowest(kTetCorners, std::numbers::sqrt2);
+  if (c.size == 8) return lowest(kHexCorners, 1.0);
   // Pyramid: base corners, and every sub-tetrahedron of both base diagonals must be positive.
   const auto& v = c.v;
   const double tets = std::min(
       {tet6(x[v[0]], x[v[1]], x[v[2]], x[v[4]]), tet6(x[v[0]], x[v[2]], x[v[3]], x[v[4]]),
        tet6(x[v[0]], x[v[1]], x[v[3]], x[v[4]]), tet6(x[v[1]], x[v[2]], x[v[3]], x[v[4]])});
   if (!(tets > 0.0)) return -1.0;
-  return std::min({corner(0, 1, 3, 4), corner(1, 2, 0, 4), corner(2, 3, 1, 4), corner(3, 0, 2, 4)});
+  return lowest(kPyramidCorners, std::numbers::sqrt2);
 }
 
 Vec face_normal(const Face& f, const std::vector<Vec>& x) {
@@ -543,7 +539,7 @@ ImproveStats improve_mesh(HybridMesh& mesh, double voxel_size, const ImproveOpti
       // Not after a warp: its flat cells lie on the wall, where the next collapse is often
       // refused, and would stay flat.
       const auto& edges_of = cell_edges(after.size);
-      for (std::size_t k = 0; k < edges_of.size() && !warp; ++k) {
+      for (std::size_t k = 0; !warp && k < edges_of.size(); ++k) {
         const NodeId p = after.v[edges_of[k][0]], q = after.v[edges_of[k][1]];
         if (p != a && q != a) continue;
         const NodeId other = p == a ? q : p;

@@ -41,23 +41,14 @@ std::vector<std::array<int, 2>> adjacent_faces(std::span<const CellFace> faces) 
 
 const Shape kTet{kTetFaces,
                  adjacent_faces(kTetFaces),
-                 {{{0, 1, 2, 3}}, {{1, 2, 0, 3}}, {{2, 0, 1, 3}}, {{3, 0, 2, 1}}},
+                 {kTetCorners.begin(), kTetCorners.end()},
                  std::numbers::sqrt2};
 const Shape kPyramid{kPyramidFaces,
                      adjacent_faces(kPyramidFaces),
-                     {{{0, 1, 3, 4}}, {{1, 2, 0, 4}}, {{2, 3, 1, 4}}, {{3, 0, 2, 4}}},
+                     {kPyramidCorners.begin(), kPyramidCorners.end()},
                      std::numbers::sqrt2};
-const Shape kHex{kHexFaces,
-                 adjacent_faces(kHexFaces),
-                 {{{0, 1, 3, 4}},
-                  {{1, 2, 0, 5}},
-                  {{2, 3, 1, 6}},
-                  {{3, 0, 2, 7}},
-                  {{4, 7, 5, 0}},
-                  {{5, 4, 6, 1}},
-                  {{6, 5, 7, 2}},
-                  {{7, 6, 4, 3}}},
-                 1.0};
+const Shape kHex{
+    kHexFaces, adjacent_faces(kHexFaces), {kHexCorners.begin(), kHexCorners.end()}, 1.0};
 
 Vec face_normal(const CellFace& f, std::span<const Vec> x) {
   const auto& v = f.v;

@@ -76,8 +76,7 @@ class Scorer {
     for (int f = 0; f < 4; ++f)
       for (int g = f + 1; g < 4; ++g) cos_max = std::max(cos_max, -n[f].dot(n[g]));
     const double dihedral = std::acos(std::clamp(cos_max, -1.0, 1.0)) * kDegreesPerRadian;
-    constexpr int corners[4][4] = {{0, 1, 2, 3}, {1, 2, 0, 3}, {2, 0, 1, 3}, {3, 0, 2, 1}};
-    return std::min({dihedral / dihedral_, jacobian(x, corners) / jacobian_,
+    return std::min({dihedral / dihedral_, jacobian(x, kTetCorners) / jacobian_,
                      ratio_ / edge_ratio(x, kTetEdges)});
   }
   double pyramid(const std::array<Vec, 8>& x) const {
@@ -85,20 +84,19 @@ class Scorer {
     if (!(std::min({tet_volume(x[0], x[1], x[2], x[4]), tet_volume(x[0], x[2], x[3], x[4]),
                     tet_volume(x[0], x[1], x[3], x[4]), tet_volume(x[1], x[2], x[3], x[4])}) > 0.0))
       return -1.0;
-    constexpr int corners[4][4] = {{0, 1, 3, 4}, {1, 2, 0, 4}, {2, 3, 1, 4}, {3, 0, 2, 4}};
-    return std::min(jacobian(x, corners) / jacobian_, ratio_ / edge_ratio(x, kPyramidEdges));
+    return std::min(jacobian(x, kPyramidCorners) / jacobian_,
+                    ratio_ / edge_ratio(x, kPyramidEdges));
   }
   double hex(const std::array<Vec, 8>& x) const {
-    constexpr int corners[8][4] = {{0, 1, 3, 4}, {1, 2, 0, 5}, {2, 3, 1, 6}, {3, 0, 2, 7},
-                                   {4, 7, 5, 0}, {5, 4, 6, 1}, {6, 5, 7, 2}, {7, 6, 4, 3}};
-    const double j = jacobian(x, corners) / std::numbers::sqrt2;
+    const double j = jacobian(x, kHexCorners) / std::numbers::sqrt2;
     if (!(j > 0.0)) return -1.0;
     return std::min(j / jacobian_, ratio_ / edge_ratio(x, kHexEdges));
   }
   // The smallest corner Jacobian over the edge lengths, scaled to 1 for the regular cell (the
   // quality report's scaled Jacobian).
   template <std::size_t N>
-  static double jacobian(const std::array<Vec, 8>& x, const int (&corners)[N][4]) {
+  static double jacobian(const std::array<Vec, 8>& x,
+                         const std::array<std::array<int, 4>, N>& corners) {
     double j = INFINITY;
     for (const auto& c : corners) {
       const Vec a = x[c[1]] - x[c[0]], b = x[c[2]] - x[c[0]], e = x[c[3]] - x[c[0]];

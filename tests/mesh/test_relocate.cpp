@@ -272,15 +272,12 @@ TEST(Relocate, SphereSignedDistancesMeetTheQualityTargets) {
   for (const auto& [name, centre] :
        {std::pair{"benchmark's sphere", Eigen::Vector3d(31.5, 31.5, 31.5)},
         std::pair{"sphere off centre", Eigen::Vector3d(31.37, 31.71, 31.13)}}) {
-    Volume<float> sphere;
-    sphere.frame.dims = {n, n, n};
-    sphere.values.resize(sphere.frame.voxel_count());
-    for (int k = 0; k < n; ++k)
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i)
-          sphere.values[sphere.frame.index(i, j, k)] =
-              static_cast<float>(radius - (Eigen::Vector3d(i, j, k) - centre).norm());
-    write_field_nrrd(sphere, dir / "sphere.nrrd");
+    write_field_nrrd(
+        testing::sampled_volume<float>(n, n, n,
+                                       [&](int i, int j, int k) {
+                                         return radius - (Eigen::Vector3d(i, j, k) - centre).norm();
+                                       }),
+        dir / "sphere.nrrd");
     MeshJob job;
     job.input = dir / "sphere.nrrd";
     job.threshold = 0.0;
