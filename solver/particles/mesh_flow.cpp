@@ -48,6 +48,18 @@ void inverse_map(const Eigen::Matrix<double, N, 3>& X, const Vec3& x, Vec3 xi, b
   if (gradient) *gradient = s.gradient * (X.transpose() * s.gradient).inverse();
 }
 
+// Triangle `half` of a cell's local face, counter-clockwise seen from outside; a quadrilateral
+// is split along the diagonal through its lowest node id, the same split from both sides.
+std::array<NodeId, 3> face_triangle(std::span<const NodeId> ids, const CellFace& face, int half) {
+  const auto& v = face.v;
+  if (face.size == 3) return {ids[v[0]], ids[v[1]], ids[v[2]]};
+  const std::array<NodeId, 4> q{ids[v[0]], ids[v[1]], ids[v[2]], ids[v[3]]};
+  const std::size_t m = static_cast<std::size_t>(std::min_element(q.begin(), q.end()) - q.begin());
+  auto corner = [&](std::size_t k) { return q[(m + k) % 4]; };
+  if (half == 0) return {corner(0), corner(1), corner(2)};
+  return {corner(0), corner(2), corner(3)};
+}
+
 }  // namespace
 
 MeshFlow::MeshFlow(const HybridMesh& mesh, std::span<const Vec3> velocity,
@@ -106,7 +118,7 @@ MeshFlow::MeshFlow(const HybridMesh& mesh, std::span<const Vec3> velocity,
     const auto ids = cell_nodes(static_cast<int>(cell));
     const auto local = cell_faces(static_cast<int>(ids.size()));
     std::size_t at = plane_start_[cell];
-    auto add_plane = [&](std::size_t f, NodeId a, NodeId b, NodeId d) {
+    auto add_plane = [&](std::size_t f, int half, NodeId a, NodeId b, NodeId d) {
       const Vec3& pa = nodes_[static_cast<std::size_t>(a)];
       const Vec3 normal = (nodes_[static_cast<std::size_t>(b)] - pa)
                               .cross(nodes_[static_cast<std::size_t>(d)] - pa)
@@ -116,19 +128,36 @@ MeshFlow::MeshFlow(const HybridMesh& mesh, std::span<const Vec3> velocity,
                 static_cast<float>(normal[2])};
       p.offset = p.n().dot(pa);
       p.face = static_cast<std::int8_t>(f);
+      p.half = static_cast<std::int8_t>(half);
     };
     for (std::size_t f = 0; f < local.size(); ++f) {
-      const auto& v = local[f].v;
-      if (local[f].size == 3) {
-        add_plane(f, ids[v[0]], ids[v[1]], ids[v[2]]);
-        continue;
+      for (int half = 0; half < (local[f].size == 3 ? 1 : 2); ++half) {
+        const auto t = face_triangle(ids, local[f], half);
+        add_plane(f, half, t[0], t[1], t[2]);
       }
-      const std::array<NodeId, 4> q{ids[v[0]], ids[v[1]], ids[v[2]], ids[v[3]]};
-      const std::size_t m =
-          static_cast<std::size_t>(std::min_element(q.begin(), q.end()) - q.begin());
-      auto corner = [&](std::size_t k) { return q[(m + k) % 4]; };
-      add_plane(f, corner(0), corner(1), corner(2));
-      add_plane(f, corner(0), corner(2), corner(3));
+    }
+  }
+
+  // Convex cells with plane faces: no node outside the plane of a face triangle, none of a face
+  // off it, by more than rounding.
+  convex_.assign(n, 1);
+  for (std::size_t cell = 0; cell < n; ++cell) {
+    const auto ids = cell_nodes(static_cast<int>(cell));
+    if (ids.size() == 4) continue;
+    const auto local = cell_faces(static_cast<int>(ids.size()));
+    for (const Plane& p : planes_of(static_cast<int>(cell))) {
+      const auto tri = triangle(static_cast<int>(cell), p);
+      const Vec3& p0 = nodes_[static_cast<std::size_t>(tri[0])];
+      const Vec3 normal = (nodes_[static_cast<std::size_t>(tri[1])] - p0)
+                              .cross(nodes_[static_cast<std::size_t>(tri[2])] - p0)
+                              .normalized();
+      const double tolerance = 1e-9 * size_[cell];
+      for (NodeId v : ids)
+        if (normal.dot(nodes_[static_cast<std::size_t>(v)] - p0) > tolerance) convex_[cell] = 0;
+      const CellFace& f = local[static_cast<std::size_t>(p.face)];
+      for (int k = 0; k < f.size; ++k)
+        if (normal.dot(nodes_[static_cast<std::size_t>(ids[f.v[k]])] - p0) < -tolerance)
+          convex_[cell] = 0;
     }
   }
 
@@ -259,6 +288,90 @@ Vec3 MeshFlow::cell_centre(int cell) const {
   return c / static_cast<double>(cell_nodes(cell).size());
 }
 
+std::array<NodeId, 3> MeshFlow::triangle(int cell, const Plane& p) const {
+  const auto ids = cell_nodes(cell);
+  return face_triangle(
+      ids, cell_faces(static_cast<int>(ids.size()))[static_cast<std::size_t>(p.face)], p.half);
+}
+
+double MeshFlow::wall_shift(int cell, int face, double radius) const {
+  if (!(radius > 0.0)) return 0.0;
+  const std::int32_t next =
+      neighbour_[6 * static_cast<std::size_t>(cell) + static_cast<std::size_t>(face)];
+  if (next >= 0 ||
+      open_patch_[static_cast<std::size_t>(boundary_patch_[static_cast<std::size_t>(-1 - next)])])
+    return 0.0;
+  return radius;
+}
+
+bool MeshFlow::crosses_outwards(int cell, const Plane& p, const Vec3& a, const Vec3& d,
+                                double& t) const {
+  const auto tri = triangle(cell, p);
+  const Vec3 p0 = nodes_[static_cast<std::size_t>(tri[0])] - a,
+             p1 = nodes_[static_cast<std::size_t>(tri[1])] - a,
+             p2 = nodes_[static_cast<std::size_t>(tri[2])] - a;
+  const double s0 = d.dot(p0.cross(p1)), s1 = d.dot(p1.cross(p2)), s2 = d.dot(p2.cross(p0));
+  if (!(s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0 && s0 + s1 + s2 > 0.0)) return false;
+  const Vec3 normal = (p1 - p0).cross(p2 - p0);
+  t = normal.dot(p0) / normal.dot(d);
+  return true;
+}
+
+const MeshFlow::Plane* MeshFlow::exit(int cell, int entry, const Vec3& a, const Vec3& d,
+                                      double t_now, double radius, double& t) const {
+  // Crossings up to 10⁻⁹ cell sizes behind the point reached count: rounding, not geometry.
+  const double behind = 1e-9 * size_[static_cast<std::size_t>(cell)] / std::max(d.norm(), 1e-300);
+  const bool convex = convex_[static_cast<std::size_t>(cell)] != 0;
+  // The first plane the line crosses outwards: in a convex cell, the exit. Of the face entered
+  // through, only a triangle the line crosses outwards (a fold of a non-convex cell) counts.
+  const Plane* first = nullptr;
+  double t_first = std::numeric_limits<double>::infinity();
+  for (const Plane& p : planes_of(cell)) {
+    const double nd = p.n().dot(d);
+    if (!(nd > 0.0)) continue;
+    double tf;
+    if (p.face != entry)
+      tf = (p.offset - wall_shift(cell, p.face, radius) - p.n().dot(a)) / nd;
+    else if (convex || !crosses_outwards(cell, p, a, d, tf) || !(tf >= t_now - behind))
+      continue;
+    if (tf < t_first) {
+      t_first = tf;
+      first = &p;
+    }
+  }
+  // In a convex cell, beyond the segment, on a wall plane shifted by the radius (met as a
+  // plane), or crossed within its triangle: the exit. A non-convex cell's first plane may be
+  // crossed outside its triangle.
+  double t_check;
+  if (convex || !first || t_first >= 1.0 || wall_shift(cell, first->face, radius) > 0.0 ||
+      (crosses_outwards(cell, *first, a, d, t_check) && t_check >= t_now - behind)) {
+    t = t_first;
+    return first;
+  }
+  // The first triangle the line crosses outwards after t_now.
+  const Plane* best = nullptr;
+  t = std::numeric_limits<double>::infinity();
+  for (const Plane& p : planes_of(cell)) {
+    double tf;
+    if (const double shift = wall_shift(cell, p.face, radius); shift > 0.0) {
+      const double nd = p.n().dot(d);
+      if (!(nd > 0.0)) continue;
+      tf = (p.offset - shift - p.n().dot(a)) / nd;
+    } else if (!crosses_outwards(cell, p, a, d, tf) || !(tf >= t_now - behind)) {
+      continue;
+    }
+    if (tf < t) {
+      t = tf;
+      best = &p;
+    }
+  }
+  if (best) return best;
+  // Rounding left the line crossing no triangle outwards (or the segment starts outside the
+  // cell): the first plane, as in a convex cell.
+  t = t_first;
+  return first;
+}
+
 Passage MeshFlow::pass(const Vec3& a, const Vec3& b, int& cell, double radius) const {
   const Vec3 d = b - a;
   Passage result;
@@ -266,28 +379,8 @@ Passage MeshFlow::pass(const Vec3& a, const Vec3& b, int& cell, double radius) c
   double t_now = 0.0;
   for (int visit = 0; visit < kMaxWalk; ++visit) {
     ++result.cell_tests;
-    const std::span<const Plane> planes = planes_of(cell);
-    double best_t = std::numeric_limits<double>::infinity();
-    const Plane* best = nullptr;
-    for (const Plane& p : planes) {
-      const int f = p.face;
-      if (f == entry) continue;
-      const Vec3 n = p.n();
-      const double nd = n.dot(d);
-      if (!(nd > 0.0)) continue;
-      const std::int32_t next =
-          neighbour_[6 * static_cast<std::size_t>(cell) + static_cast<std::size_t>(f)];
-      double shift = 0.0;
-      if (radius > 0.0 && next < 0 &&
-          !open_patch_[static_cast<std::size_t>(
-              boundary_patch_[static_cast<std::size_t>(-1 - next)])])
-        shift = radius;
-      const double tf = (p.offset - shift - n.dot(a)) / nd;
-      if (tf < best_t) {
-        best_t = tf;
-        best = &p;
-      }
-    }
+    double best_t;
+    const Plane* best = exit(cell, entry, a, d, t_now, radius, best_t);
     if (!best || best_t >= 1.0) return result;
     const std::size_t slot =
         6 * static_cast<std::size_t>(cell) + static_cast<std::size_t>(best->face);

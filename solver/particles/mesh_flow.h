@@ -2,18 +2,18 @@
 // The FE velocity field of a naris solution on its hybrid mesh, for particle tracking.
 //
 // Location walks from cell to face neighbour along the straight segment between two points:
-// each cell is bounded by the planes of its faces (a quadrilateral split into two triangles
-// along the diagonal through its lowest node id, the same split from both sides, so the cells
-// tile the domain without gaps), the walk leaves a cell through the first plane the segment
-// crosses outwards, and a boundary face ends it: leaving the domain is found exactly, never by
-// a distance search. A point's first cell comes from a uniform bucket grid (O(1)), then the
-// same walk from the centre of a candidate cell. Velocity is the solver's interpolant (P1
-// tetrahedra, Q1 hexahedra, the rational pyramid) at the point's reference coordinates
-// (barycentric in tetrahedra, Newton's inverse mapping in pyramids and hexahedra). In a cell that
-// touches the wall, w = Σ N_i over its nodes off the wall grows like the distance from the wall's
-// nodes, and the velocity's component along ∇w is scaled by w: the wall-normal velocity then
-// vanishes as d² at a no-slip wall, as continuity requires (the plain interpolant's u·n ∝ d
-// draws tracers and small particles onto the wall).
+// each cell is bounded by the triangles of its faces (a quadrilateral split into two along the
+// diagonal through its lowest node id, the same split from both sides, so the cells tile the
+// domain without gaps), the walk leaves a cell through the first triangle the segment crosses
+// outwards (which also holds in the non-convex cells whose faces a warp or a relocation bent),
+// and a boundary face ends it: leaving the domain is found exactly, never by a distance search. A
+// point's first cell comes from a uniform bucket grid (O(1)), then the same walk from the centre of
+// a candidate cell. Velocity is the solver's interpolant (P1 tetrahedra, Q1 hexahedra, the rational
+// pyramid) at the point's reference coordinates (barycentric in tetrahedra, Newton's inverse
+// mapping in pyramids and hexahedra). In a cell that touches the wall, w = Σ N_i over its nodes off
+// the wall grows like the distance from the wall's nodes, and the velocity's component along ∇w is
+// scaled by w: the wall-normal velocity then vanishes as d² at a no-slip wall, as continuity
+// requires (the plain interpolant's u·n ∝ d draws tracers and small particles onto the wall).
 #include <array>
 #include <cstdint>
 #include <span>
@@ -54,6 +54,7 @@ class MeshFlow : public FlowDomain {
     double offset;
     std::array<float, 3> unit;
     std::int8_t face;  // the cell's local face
+    std::int8_t half;  // a quadrilateral's triangle: 0 or 1 (a triangle face: 0)
     Vec3 n() const { return {unit[0], unit[1], unit[2]}; }
   };
   std::span<const Plane> planes_of(int cell) const {
@@ -65,6 +66,18 @@ class MeshFlow : public FlowDomain {
             static_cast<std::size_t>(count_[static_cast<std::size_t>(cell)])};
   }
   bool inside(int cell, const Vec3& x, double tolerance) const;
+  // `radius` on a wall face of the cell (interception), 0 elsewhere.
+  double wall_shift(int cell, int face, double radius) const;
+  // The nodes of plane p's triangle, counter-clockwise seen from outside the cell.
+  std::array<NodeId, 3> triangle(int cell, const Plane& p) const;
+  // Whether the line a + t·d crosses plane p's triangle outwards (Plücker signs: exactly
+  // opposite on the two sides of an edge, so a line through an edge takes one way), and where.
+  bool crosses_outwards(int cell, const Plane& p, const Vec3& a, const Vec3& d, double& t) const;
+  // The face triangle through which the line a + t·d leaves `cell` after t_now, and its t: the
+  // first triangle the line crosses outwards; with `radius`, a wall plane shifted inwards by it
+  // counts too. nullptr: no plane faces along d.
+  const Plane* exit(int cell, int entry, const Vec3& a, const Vec3& d, double t_now, double radius,
+                    double& t) const;
   // Shape values (and physical gradients, when asked) of `cell` at x; returns the node count.
   int shape(int cell, const Vec3& x, std::array<double, 8>& value,
             std::array<Vec3, 8>* gradient) const;
@@ -84,6 +97,7 @@ class MeshFlow : public FlowDomain {
   BigVector<std::uint8_t> wall_node_;      // 1: on a wall face (no slip)
   BigVector<std::uint8_t> wall_touching_;  // 1: the cell has a node on the wall
   BigVector<std::uint8_t> affine_;         // 1: a parallelepiped hexahedron
+  BigVector<std::uint8_t> convex_;         // 1: convex, with plane faces
   std::vector<std::string> patch_names_;
 
   // Bucket grid: the cells whose bounding box meets each bucket (CSR).

@@ -6,6 +6,7 @@
 // comparison is a benchmark (tests/bench/bench_deposition.cpp), as it takes a minute.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -130,6 +131,75 @@ TEST(ParticleTracking, ReleasePointsOnABumpyInletLieInsideTheAirway) {
   EXPECT_LE(largest_step_outside, 1.5e-7);
   EXPECT_LE(largest_step, 1.03e-4);
   EXPECT_GT(outside_before, 0);  // the mean plane alone misses the face somewhere
+}
+
+// Hexahedra whose faces a warp or a relocation bent are non-convex: a segment can cross a face
+// triangle's plane outside the triangle. In a box of 8³ cubes whose inner nodes are moved at
+// random by up to a quarter of a cube (every cell star-shaped about its centroid), walks along
+// random segments end, and end in the cell that holds the segment's end: the one whose
+// tetrahedra from the centroid to its face triangles (each quadrilateral split along the
+// diagonal through its lowest node id, as mesh_flow.h states) contain it.
+TEST(ParticleTracking, WalksThroughWarpedHexahedraEndInTheCellHoldingTheEnd) {
+  constexpr int n = 8;
+  constexpr double h = 2.0 / n;
+  HybridMesh m = testing::box_hex(n);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> jitter(-0.25 * h, 0.25 * h);
+  for (Vec3& x : m.nodes)
+    if (x.cwiseAbs().maxCoeff() < 1.0 - 1e-9) x += Vec3(jitter(rng), jitter(rng), jitter(rng));
+  const MeshFlow flow(m, std::vector<Vec3>(m.nodes.size(), Vec3::Zero()), {});
+
+  // Per cell: its centroid and face triangles (mm), the tetrahedra each of positive volume.
+  struct Tet {
+    Vec3 a, b, c, d;
+  };
+  std::vector<std::vector<Tet>> star(m.hexes.size());
+  int non_convex = 0;
+  for (std::size_t c = 0; c < m.hexes.size(); ++c) {
+    const auto& hex = m.hexes[c];
+    Vec3 centre = Vec3::Zero();
+    for (NodeId v : hex) centre += m.nodes[static_cast<std::size_t>(v)] / 8.0;
+    bool convex = true;
+    for (const CellFace& f : cell_faces(8)) {
+      std::array<NodeId, 4> q{hex[f.v[0]], hex[f.v[1]], hex[f.v[2]], hex[f.v[3]]};
+      std::rotate(q.begin(), std::min_element(q.begin(), q.end()), q.end());
+      for (const auto& tri : {std::array<NodeId, 3>{q[0], q[1], q[2]}, {q[0], q[2], q[3]}}) {
+        const Vec3 &a = m.nodes[static_cast<std::size_t>(tri[0])],
+                   &b = m.nodes[static_cast<std::size_t>(tri[1])],
+                   &d = m.nodes[static_cast<std::size_t>(tri[2])];
+        ASSERT_GT((a - centre).dot((b - centre).cross(d - centre)), 0.0) << "cell " << c;
+        star[c].push_back({centre, a, b, d});
+        const Vec3 normal = (b - a).cross(d - a).normalized();
+        for (NodeId v : hex)
+          if (normal.dot(m.nodes[static_cast<std::size_t>(v)] - a) > 1e-3 * h) convex = false;
+      }
+    }
+    non_convex += !convex;
+  }
+  auto holds = [&](std::size_t c, const Vec3& x) {
+    for (const Tet& t : star[c]) {
+      Eigen::Matrix3d A;
+      A << t.b - t.a, t.c - t.a, t.d - t.a;
+      const Vec3 l = A.inverse() * (x - t.a);
+      if (l.minCoeff() >= 0.0 && l.sum() <= 1.0) return true;
+    }
+    return false;
+  };
+  EXPECT_GT(non_convex, 100);  // of the 216 cells off the box's sides
+
+  std::uniform_real_distribution<double> inner(-0.9, 0.9), step(-2.0 * h, 2.0 * h);
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 a(inner(rng), inner(rng), inner(rng));
+    const Vec3 b = (a + Vec3(step(rng), step(rng), step(rng))).cwiseMax(-0.9).cwiseMin(0.9);
+    int cell = flow.locate(a * kMm);
+    ASSERT_GE(cell, 0) << a.transpose();
+    ASSERT_TRUE(holds(static_cast<std::size_t>(cell), a)) << "located " << a.transpose();
+    const Passage p = flow.pass(a * kMm, b * kMm, cell, 0.0);
+    ASSERT_FALSE(p.stuck) << a.transpose() << " → " << b.transpose();
+    ASSERT_FALSE(p.left) << a.transpose() << " → " << b.transpose();
+    EXPECT_TRUE(holds(static_cast<std::size_t>(cell), b))
+        << a.transpose() << " → " << b.transpose() << " ended in cell " << cell;
+  }
 }
 
 // In a cell with a wall face the wall-normal velocity is scaled by d/h (vanishing as d²), the
