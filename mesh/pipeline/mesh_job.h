@@ -33,9 +33,8 @@ struct MeshJob {
   bool keep_largest = true;
   bool improve = true;
   ImproveOptions improve_options;
-  // Node relocation and wall-sliver removal after the collapses (relocate.h); off by default
-  // while it does not yet reach its targets.
-  bool relocate = false;
+  // Node relocation and wall-sliver removal after the collapses (relocate.h).
+  bool relocate = true;
   RelocateOptions relocate_options;
   // Uniform refinements after the improvement (refine/subdivide.h): each multiplies the cells
   // by 8 and keeps the geometry, for mesh-convergence studies on one anatomy.
