@@ -312,26 +312,31 @@ bool MeshFlow::crosses_outwards(int cell, const Plane& p, const Vec3& a, const V
              p2 = nodes_[static_cast<std::size_t>(tri[2])] - a;
   const double s0 = d.dot(p0.cross(p1)), s1 = d.dot(p1.cross(p2)), s2 = d.dot(p2.cross(p0));
   if (!(s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0 && s0 + s1 + s2 > 0.0)) return false;
-  const Vec3 normal = (p1 - p0).cross(p2 - p0);
-  t = normal.dot(p0) / normal.dot(d);
+  t = p0.dot(p1.cross(p2)) / (s0 + s1 + s2);  // the products' sum is the normal's n·d > 0
   return true;
 }
 
-const MeshFlow::Plane* MeshFlow::exit(int cell, int entry, const Vec3& a, const Vec3& d,
-                                      double t_now, double radius, double& t) const {
-  // Crossings up to 10⁻⁹ cell sizes behind the point reached count: rounding, not geometry.
-  const double behind = 1e-9 * size_[static_cast<std::size_t>(cell)] / std::max(d.norm(), 1e-300);
+double MeshFlow::plane_crossing(int cell, const Plane& p, const Vec3& a, const Vec3& d,
+                                double radius) const {
+  const double nd = p.n().dot(d);
+  if (!(nd > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return (p.offset - wall_shift(cell, p.face, radius) - p.n().dot(a)) / nd;
+}
+
+const MeshFlow::Plane* MeshFlow::exit_plane(int cell, int entry, const Vec3& a, const Vec3& d,
+                                            double t_now, double radius, double& t) const {
+  // Crossings up to 10⁻⁶ cell sizes behind the point reached count: t_now may come from a plane
+  // of single-precision normal, off by about 10⁻⁷ cell sizes.
+  const double behind = 1e-6 * size_[static_cast<std::size_t>(cell)] / std::max(d.norm(), 1e-300);
   const bool convex = convex_[static_cast<std::size_t>(cell)] != 0;
   // The first plane the line crosses outwards: in a convex cell, the exit. Of the face entered
   // through, only a triangle the line crosses outwards (a fold of a non-convex cell) counts.
   const Plane* first = nullptr;
   double t_first = std::numeric_limits<double>::infinity();
   for (const Plane& p : planes_of(cell)) {
-    const double nd = p.n().dot(d);
-    if (!(nd > 0.0)) continue;
     double tf;
     if (p.face != entry)
-      tf = (p.offset - wall_shift(cell, p.face, radius) - p.n().dot(a)) / nd;
+      tf = plane_crossing(cell, p, a, d, radius);
     else if (convex || !crosses_outwards(cell, p, a, d, tf) || !(tf >= t_now - behind))
       continue;
     if (tf < t_first) {
@@ -339,9 +344,9 @@ const MeshFlow::Plane* MeshFlow::exit(int cell, int entry, const Vec3& a, const 
       first = &p;
     }
   }
-  // In a convex cell, beyond the segment, on a wall plane shifted by the radius (met as a
-  // plane), or crossed within its triangle: the exit. A non-convex cell's first plane may be
-  // crossed outside its triangle.
+  // The first plane is the exit in a convex cell with plane faces, beyond the segment, as a wall
+  // plane shifted by the radius (met as a plane), or where its triangle is crossed; a bent
+  // cell's first plane may be crossed outside its triangle.
   double t_check;
   if (convex || !first || t_first >= 1.0 || wall_shift(cell, first->face, radius) > 0.0 ||
       (crosses_outwards(cell, *first, a, d, t_check) && t_check >= t_now - behind)) {
@@ -353,13 +358,10 @@ const MeshFlow::Plane* MeshFlow::exit(int cell, int entry, const Vec3& a, const 
   t = std::numeric_limits<double>::infinity();
   for (const Plane& p : planes_of(cell)) {
     double tf;
-    if (const double shift = wall_shift(cell, p.face, radius); shift > 0.0) {
-      const double nd = p.n().dot(d);
-      if (!(nd > 0.0)) continue;
-      tf = (p.offset - shift - p.n().dot(a)) / nd;
-    } else if (!crosses_outwards(cell, p, a, d, tf) || !(tf >= t_now - behind)) {
+    if (wall_shift(cell, p.face, radius) > 0.0)
+      tf = plane_crossing(cell, p, a, d, radius);
+    else if (!crosses_outwards(cell, p, a, d, tf) || !(tf >= t_now - behind))
       continue;
-    }
     if (tf < t) {
       t = tf;
       best = &p;
@@ -380,7 +382,7 @@ Passage MeshFlow::pass(const Vec3& a, const Vec3& b, int& cell, double radius) c
   for (int visit = 0; visit < kMaxWalk; ++visit) {
     ++result.cell_tests;
     double best_t;
-    const Plane* best = exit(cell, entry, a, d, t_now, radius, best_t);
+    const Plane* best = exit_plane(cell, entry, a, d, t_now, radius, best_t);
     if (!best || best_t >= 1.0) return result;
     const std::size_t slot =
         6 * static_cast<std::size_t>(cell) + static_cast<std::size_t>(best->face);

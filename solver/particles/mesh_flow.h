@@ -66,6 +66,10 @@ class MeshFlow : public FlowDomain {
             static_cast<std::size_t>(count_[static_cast<std::size_t>(cell)])};
   }
   bool inside(int cell, const Vec3& x, double tolerance) const;
+  // Where the line a + t·d crosses plane p outwards, shifted inwards by wall_shift; NaN if it
+  // does not face along d.
+  double plane_crossing(int cell, const Plane& p, const Vec3& a, const Vec3& d,
+                        double radius) const;
   // `radius` on a wall face of the cell (interception), 0 elsewhere.
   double wall_shift(int cell, int face, double radius) const;
   // The nodes of plane p's triangle, counter-clockwise seen from outside the cell.
@@ -76,8 +80,8 @@ class MeshFlow : public FlowDomain {
   // The face triangle through which the line a + t·d leaves `cell` after t_now, and its t: the
   // first triangle the line crosses outwards; with `radius`, a wall plane shifted inwards by it
   // counts too. nullptr: no plane faces along d.
-  const Plane* exit(int cell, int entry, const Vec3& a, const Vec3& d, double t_now, double radius,
-                    double& t) const;
+  const Plane* exit_plane(int cell, int entry, const Vec3& a, const Vec3& d, double t_now,
+                          double radius, double& t) const;
   // Shape values (and physical gradients, when asked) of `cell` at x; returns the node count.
   int shape(int cell, const Vec3& x, std::array<double, 8>& value,
             std::array<Vec3, 8>* gradient) const;

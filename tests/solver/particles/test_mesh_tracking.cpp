@@ -185,7 +185,7 @@ TEST(ParticleTracking, WalksThroughWarpedHexahedraEndInTheCellHoldingTheEnd) {
     }
     return false;
   };
-  EXPECT_GT(non_convex, 100);  // of the 216 cells off the box's sides
+  EXPECT_GT(non_convex, 100);  // of 512
 
   std::uniform_real_distribution<double> inner(-0.9, 0.9), step(-2.0 * h, 2.0 * h);
   for (int i = 0; i < 4000; ++i) {
