@@ -6,6 +6,7 @@
 #include <random>
 #include <span>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "core/log.h"
 #include "mesh/quality/node_incidence.h"
@@ -360,8 +361,13 @@ class Relocator {
     const std::size_t n_cells = cells_.count();
     score_of_.resize(n_cells);
     auto at = [&](NodeId n) -> const Vec& { return mesh_.nodes[n]; };
-    for (std::size_t c = 0; c < n_cells; ++c)
-      score_of_[c] = static_cast<float>(score_(cells_[c], at));
+    // A cell without a movable node (most hexahedra) never changes, nor joins the queue.
+    for (std::size_t c = 0; c < n_cells; ++c) {
+      const auto nodes = cells_[c];
+      const bool movable = std::any_of(nodes.begin(), nodes.end(),
+                                       [&](NodeId n) { return freedom_[n] != Freedom::fixed; });
+      score_of_[c] = movable ? static_cast<float>(score_(nodes, at)) : 1.0f;
+    }
 
     // A node is tried again only after a neighbour moved.
     std::vector<char> moved(mesh_.nodes.size(), 0), stale(mesh_.nodes.size(), 1);
@@ -634,7 +640,7 @@ class Relocator {
   std::unordered_map<NodeId, std::array<NodeId, 2>> rim_ends_;  // of `along` nodes
   std::vector<Plane> planes_;                                   // of each patch
   NodeIncidence node_cells_, node_faces_;
-  std::vector<float> score_of_;  // of every cell, as the nodes stand
+  std::vector<float> score_of_;  // of every cell with a movable node, as the nodes stand; 1 else
   std::vector<double> scores_;   // of the cells around the node being moved
   std::vector<Vec> gradients_;   // of those that may become its worst
 };
@@ -674,12 +680,24 @@ std::size_t remove_boundary_slivers(HybridMesh& mesh, const std::vector<bool>& o
   }
   if (candidates.empty()) return 0;
 
+  // Only the candidates' faces and edges are ever looked up: the tables hold those alone.
+  std::unordered_set<Key, KeyHash> candidate_face;
+  std::unordered_map<std::uint64_t, int> wall_edge;  // boundary triangles on each such edge
+  for (std::size_t c : candidates) {
+    const auto& t = mesh.tets[c];
+    for (const auto& f : kTetFaces)
+      candidate_face.insert(sorted({t[f.v[0]], t[f.v[1]], t[f.v[2]]}));
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) wall_edge.emplace(edge_key(t[a], t[b]), 0);
+  }
   std::unordered_map<Key, std::int32_t, KeyHash> wall_tri;
-  std::unordered_map<std::uint64_t, int> wall_edge;  // boundary triangles on each edge
   for (std::size_t f = 0; f < mesh.boundary_tris.size(); ++f) {
     const auto& t = mesh.boundary_tris[f];
-    wall_tri[sorted(t)] = static_cast<std::int32_t>(f);
-    for (int k = 0; k < 3; ++k) ++wall_edge[edge_key(t[k], t[(k + 1) % 3])];
+    if (const Key k = sorted(t); candidate_face.count(k))
+      wall_tri[k] = static_cast<std::int32_t>(f);
+    for (int k = 0; k < 3; ++k)
+      if (const auto it = wall_edge.find(edge_key(t[k], t[(k + 1) % 3])); it != wall_edge.end())
+        ++it->second;
   }
   // Cells using each node (for the three-face case).
   std::vector<std::int32_t> uses(mesh.nodes.size(), 0);
