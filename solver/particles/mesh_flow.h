@@ -75,7 +75,8 @@ class MeshFlow : public FlowDomain {
   // The nodes of plane p's triangle, counter-clockwise seen from outside the cell.
   std::array<NodeId, 3> triangle(int cell, const Plane& p) const;
   // Whether the line a + t·d crosses plane p's triangle outwards (Plücker signs: exactly
-  // opposite on the two sides of an edge, so a line through an edge takes one way), and where.
+  // opposite on the two sides of an edge, so a line through an edge cannot slip between the two
+  // triangles), and where.
   bool crosses_outwards(int cell, const Plane& p, const Vec3& a, const Vec3& d, double& t) const;
   // The face triangle through which the line a + t·d leaves `cell` after t_now, and its t: the
   // first triangle the line crosses outwards; with `radius`, a wall plane shifted inwards by it
